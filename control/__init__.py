@@ -1,0 +1,3 @@
+"""aiorobot.control — see API.md."""
+
+__all__: list[str] = []

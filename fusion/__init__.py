@@ -1,0 +1,3 @@
+"""aiorobot.fusion — see API.md."""
+
+__all__: list[str] = []

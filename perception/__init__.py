@@ -1,0 +1,3 @@
+"""aiorobot.perception — see API.md."""
+
+__all__: list[str] = []
