@@ -1,0 +1,452 @@
+"""The graph configuration read by ``aiorobot run``: a TOML file parsed into frozen dataclasses.
+
+This module is the pure half of the loader: :func:`load_config` reads and validates a
+file and never imports user code or builds a node. :func:`aiorobot._config_build.build_nodes`
+is the other half (imports the node classes and constructs the nodes).
+
+Every problem raises :class:`ConfigError` naming the file, the key path (``nodes[1].executor``)
+and what was expected against what was found, on one line::
+
+    bad.toml: nodes[1].executor: expected "main" or "priority", found "fast"
+"""
+
+from __future__ import annotations
+
+import datetime
+import difflib
+import json
+import math
+import re
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from ._errors import InvalidNameError
+from ._names import expand_name, validate_namespace, validate_node_name
+
+__all__ = [
+    "EXECUTORS",
+    "LOG_LEVELS",
+    "ConfigError",
+    "GraphConfig",
+    "NodeConfig",
+    "RecordConfig",
+    "RuntimeConfig",
+    "TRANSPORTS",
+    "load_config",
+    "parse_config",
+]
+
+EXECUTORS = ("main", "priority")
+LOG_LEVELS = ("debug", "info", "warning", "error")
+TRANSPORTS = ("local", "zenoh")
+_AVAILABLE_TRANSPORTS = ("local",)
+_MAX_DOMAIN_ID = 232
+
+_RUNTIME_KEYS = ("transport", "domain_id", "use_sim_time", "strict_qos", "log_level")
+_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level")
+_RECORD_KEYS = ("path",)
+_TOP_KEYS = ("runtime", "nodes", "record")
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+_USE = re.compile(
+    r"^(?P<module>[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)"
+    r":(?P<attr>[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)$"
+)
+_TOML_POSITION = re.compile(r"^(?P<msg>.*) \(at (?:line (?P<line>\d+), column (?P<col>\d+)|end of document)\)$")
+
+
+class ConfigError(Exception):
+    """A configuration file is unreadable, not TOML, or does not describe a valid graph.
+
+    Attributes
+    ----------
+    path : str
+        The file, as the user named it.
+    key : str or None
+        The key path inside the file (``nodes[1].executor``), ``None`` for file-level problems.
+    message : str
+        What was expected and what was found, on one line.
+    """
+
+    def __init__(self, path: str | Path, key: str | None, message: str) -> None:
+        self.path = str(path)
+        self.key = key
+        self.message = _one_line(message)
+        super().__init__(self.path, key, self.message)
+
+    def __str__(self) -> str:
+        if self.key:
+            return f"{self.path}: {self.key}: {self.message}"
+        return f"{self.path}: {self.message}"
+
+
+@dataclass(frozen=True, slots=True)
+class RuntimeConfig:
+    """The ``[runtime]`` table: arguments of :class:`aiorobot.Runtime` and the default log level."""
+
+    transport: str = "local"
+    domain_id: int = 0
+    use_sim_time: bool = False
+    strict_qos: bool = False
+    log_level: str = "info"
+
+
+@dataclass(frozen=True, slots=True)
+class NodeConfig:
+    """One ``[[nodes]]`` table.
+
+    ``parameters`` holds flattened ROS-style names (a nested table ``{pid = {kp = 1.0}}``
+    becomes ``"pid.kp"``); arrays are tuples. ``name`` and ``namespace`` are ``None`` when
+    the file leaves them out (the node class chooses).
+    """
+
+    index: int
+    use: str
+    name: str | None = None
+    executor: str = "main"
+    namespace: str | None = None
+    parameters: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    remap: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    log_level: str | None = None
+
+    @property
+    def key(self) -> str:
+        """The key path of this table, ``nodes[<index>]``."""
+        return f"nodes[{self.index}]"
+
+    @property
+    def module_name(self) -> str:
+        return self.use.partition(":")[0]
+
+    @property
+    def class_name(self) -> str:
+        return self.use.partition(":")[2]
+
+
+@dataclass(frozen=True, slots=True)
+class RecordConfig:
+    """The ``[record]`` table (MCAP recording)."""
+
+    path: str
+
+
+@dataclass(frozen=True, slots=True)
+class GraphConfig:
+    """A validated configuration file."""
+
+    path: str
+    runtime: RuntimeConfig
+    nodes: tuple[NodeConfig, ...]
+    record: RecordConfig | None = None
+
+    @property
+    def base_dir(self) -> Path:
+        """The folder holding the file: node modules are imported from there too."""
+        return Path(self.path).resolve().parent
+
+
+def load_config(path: str | Path) -> GraphConfig:
+    """Read and validate a graph configuration file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file; error messages name it as given here.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, is not UTF-8 TOML, or does not describe a valid graph.
+    """
+    try:
+        raw = Path(path).read_bytes()
+    except OSError as err:
+        reason = err.strerror or type(err).__name__
+        raise ConfigError(path, None, f"cannot read the file: {reason}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = raw[: err.start].count(b"\n") + 1
+        raise ConfigError(
+            path, None, f"line {line}: expected UTF-8 text, found the byte 0x{raw[err.start]:02x}"
+        ) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(path, None, _toml_error_message(str(err), text)) from None
+    return parse_config(data, path)
+
+
+def parse_config(data: Mapping[str, Any], path: str | Path = "<config>") -> GraphConfig:
+    """Validate an already parsed TOML document (``tomllib.loads`` output)."""
+    checker = _Checker(str(path))
+    checker.check_keys(data, "", _TOP_KEYS)
+    runtime = _parse_runtime(checker, data.get("runtime", {}))
+    nodes = _parse_nodes(checker, data)
+    record = None
+    if "record" in data:
+        record = _parse_record(checker, data["record"])
+        raise checker.error(
+            "record", "MCAP recording is not available yet; remove the [record] table"
+        )
+    return GraphConfig(path=str(path), runtime=runtime, nodes=nodes, record=record)
+
+
+def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
+    checker.check_type(table, "runtime", dict, "a table ([runtime])")
+    checker.check_keys(table, "runtime", _RUNTIME_KEYS)
+    transport = checker.choice(table, "runtime", "transport", TRANSPORTS, "local")
+    if transport not in _AVAILABLE_TRANSPORTS:
+        raise checker.error(
+            "runtime.transport",
+            f'the "{transport}" transport is not available yet; expected "local"',
+        )
+    domain_id = table.get("domain_id", 0)
+    checker.check_type(domain_id, "runtime.domain_id", int, f"an integer 0..{_MAX_DOMAIN_ID}")
+    if not 0 <= domain_id <= _MAX_DOMAIN_ID:
+        raise checker.error(
+            "runtime.domain_id", f"expected an integer 0..{_MAX_DOMAIN_ID}, found {domain_id}"
+        )
+    use_sim_time = table.get("use_sim_time", False)
+    checker.check_type(use_sim_time, "runtime.use_sim_time", bool, "true or false")
+    strict_qos = table.get("strict_qos", False)
+    checker.check_type(strict_qos, "runtime.strict_qos", bool, "true or false")
+    log_level = checker.choice(table, "runtime", "log_level", LOG_LEVELS, "info")
+    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level)
+
+
+def _parse_nodes(checker: _Checker, data: Mapping[str, Any]) -> tuple[NodeConfig, ...]:
+    if "nodes" not in data:
+        raise checker.error(
+            "nodes", 'expected at least one [[nodes]] table with a "use" key, found none'
+        )
+    nodes = data["nodes"]
+    if isinstance(nodes, dict):
+        raise checker.error(
+            "nodes", "expected an array of tables (write [[nodes]], not [nodes]), found a table"
+        )
+    checker.check_type(nodes, "nodes", list, "an array of tables ([[nodes]])")
+    if not nodes:
+        raise checker.error("nodes", "expected at least one node, found an empty array")
+    return tuple(_parse_node(checker, i, table) for i, table in enumerate(nodes))
+
+
+def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
+    key = f"nodes[{index}]"
+    checker.check_type(table, key, dict, "a table")
+    checker.check_keys(table, key, _NODE_KEYS)
+    if "use" not in table:
+        raise checker.error(
+            f"{key}.use",
+            'missing required key; expected a "module:Class" string such as '
+            '"aiorobot.examples.sensor:ImuPublisher"',
+        )
+    use = table["use"]
+    checker.check_type(use, f"{key}.use", str, 'a "module:Class" string')
+    if not _USE.match(use):
+        raise checker.error(
+            f"{key}.use",
+            f'expected "module:Class" (a dotted module path, a colon, a class name), found {_found(use)}',
+        )
+
+    name = table.get("name")
+    if name is not None:
+        checker.check_type(name, f"{key}.name", str, "a node name string")
+        try:
+            validate_node_name(name)
+        except InvalidNameError as err:
+            raise checker.error(f"{key}.name", _name_problem(err)) from None
+
+    executor = checker.choice(table, key, "executor", EXECUTORS, "main")
+
+    namespace = table.get("namespace")
+    if namespace is not None:
+        checker.check_type(namespace, f"{key}.namespace", str, 'a namespace string such as "/base"')
+        try:
+            namespace = validate_namespace(namespace)
+        except InvalidNameError as err:
+            raise checker.error(f"{key}.namespace", _name_problem(err)) from None
+
+    parameters = table.get("parameters", {})
+    checker.check_type(parameters, f"{key}.parameters", dict, "a table of parameter values")
+    flat: dict[str, Any] = {}
+    _flatten_parameters(checker, parameters, f"{key}.parameters", "", flat)
+
+    remap = table.get("remap", {})
+    checker.check_type(remap, f"{key}.remap", dict, 'a table of "from" = "to" names')
+    for source, target in remap.items():
+        source_key = checker.join(f"{key}.remap", source)
+        if source.startswith("__"):
+            replacement = {"__node": "name", "__ns": "namespace"}.get(source)
+            hint = f"; set {key}.{replacement} instead" if replacement else ""
+            raise checker.error(
+                source_key, f"expected a topic or service name, found the special rule {_found(source)}{hint}"
+            )
+        for which, name_ in (("source", source), ("target", target)):
+            checker.check_type(name_, source_key, str, "a topic or service name string")
+            try:
+                expand_name(name_, "node", "/", "topic")
+            except InvalidNameError as err:
+                raise checker.error(source_key, f"{which}: {_name_problem(err)}") from None
+
+    log_level = checker.choice(table, key, "log_level", LOG_LEVELS, None)
+    return NodeConfig(
+        index=index,
+        use=use,
+        name=name,
+        executor=executor,
+        namespace=namespace,
+        parameters=MappingProxyType(flat),
+        remap=MappingProxyType(dict(remap)),
+        log_level=log_level,
+    )
+
+
+def _flatten_parameters(
+    checker: _Checker, table: Mapping[str, Any], key: str, prefix: str, out: dict[str, Any]
+) -> None:
+    expected = "a boolean, integer, float, string or an array of one of these"
+    for name, value in table.items():
+        value_key = checker.join(key, name)
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+            raise checker.error(
+                value_key,
+                f"expected a parameter name of letters, digits and '_' not starting with a digit, "
+                f"found {_found(name)}",
+            )
+        if isinstance(value, dict):
+            _flatten_parameters(checker, value, value_key, f"{prefix}{name}.", out)
+            continue
+        if isinstance(value, list):
+            kinds = {_scalar_kind(item) for item in value}
+            if None in kinds:
+                bad = next(item for item in value if _scalar_kind(item) is None)
+                raise checker.error(value_key, f"expected {expected}, found an array holding {_found(bad)}")
+            if kinds == {"integer", "float"}:
+                value = [float(item) for item in value]
+            elif len(kinds) > 1:
+                raise checker.error(
+                    value_key,
+                    f"expected an array of one type, found an array mixing {' and '.join(sorted(kinds))}",
+                )
+            out[prefix + name] = tuple(value)
+            continue
+        if _scalar_kind(value) is None:
+            raise checker.error(value_key, f"expected {expected}, found {_found(value)}")
+        out[prefix + name] = value
+
+
+def _scalar_kind(value: Any) -> str | None:
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, int):
+        return "integer"
+    if isinstance(value, float):
+        return "float"
+    if isinstance(value, str):
+        return "string"
+    return None
+
+
+def _parse_record(checker: _Checker, table: Any) -> RecordConfig:
+    checker.check_type(table, "record", dict, "a table ([record])")
+    checker.check_keys(table, "record", _RECORD_KEYS)
+    if "path" not in table:
+        raise checker.error("record.path", 'missing required key; expected a file name such as "run.mcap"')
+    checker.check_type(table["path"], "record.path", str, "a file name string")
+    return RecordConfig(path=table["path"])
+
+
+class _Checker:
+    """Builds :class:`ConfigError` for one file and holds the common checks."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+    def error(self, key: str | None, message: str) -> ConfigError:
+        return ConfigError(self.path, key, message)
+
+    @staticmethod
+    def join(parent: str, name: str) -> str:
+        part = name if _BARE_KEY.match(name) else json.dumps(name)
+        return f"{parent}.{part}" if parent else part
+
+    def check_keys(self, table: Mapping[str, Any], key: str, allowed: Iterable[str]) -> None:
+        allowed = tuple(allowed)
+        for name in table:
+            if name not in allowed:
+                close = difflib.get_close_matches(name, allowed, n=1, cutoff=0.6)
+                hint = f', did you mean "{close[0]}"?' if close else ""
+                raise self.error(
+                    self.join(key, name),
+                    f"unknown key{hint} (expected one of: {', '.join(allowed)})",
+                )
+
+    def check_type(self, value: Any, key: str, expected_type: type, expected: str) -> None:
+        ok = isinstance(value, expected_type)
+        if expected_type is int and isinstance(value, bool):
+            ok = False
+        if not ok:
+            raise self.error(key, f"expected {expected}, found {_found(value)}")
+
+    def choice(
+        self, table: Mapping[str, Any], parent: str, name: str, choices: tuple[str, ...], default: Any
+    ) -> Any:
+        key = self.join(parent, name)
+        value = table.get(name, default)
+        if value is default:
+            return value
+        if isinstance(value, str) and value.lower() in choices:
+            return value.lower()
+        quoted = [f'"{c}"' for c in choices]
+        options = " or ".join(quoted) if len(quoted) == 2 else ", ".join(quoted[:-1]) + " or " + quoted[-1]
+        hint = ""
+        if isinstance(value, str):
+            close = difflib.get_close_matches(value.lower(), choices, n=1, cutoff=0.6)
+            hint = f' (did you mean "{close[0]}"?)' if close else ""
+        raise self.error(key, f"expected {options}, found {_found(value)}{hint}")
+
+
+def _found(value: Any) -> str:
+    """Describe a TOML value the way the user wrote it, with its kind when that helps."""
+    if isinstance(value, bool):
+        return f"{'true' if value else 'false'} (a boolean)"
+    if isinstance(value, int):
+        return f"{value} (an integer)"
+    if isinstance(value, float):
+        text = repr(value) if math.isfinite(value) else str(value)
+        return f"{text} (a float)"
+    if isinstance(value, str):
+        text = json.dumps(value, ensure_ascii=False)
+        return text if len(text) <= 60 else text[:56] + '..."'
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        return f"a date/time ({value.isoformat()})"
+    return repr(value)
+
+
+def _name_problem(err: InvalidNameError) -> str:
+    where = f" at index {err.index}" if err.index is not None else ""
+    return f"invalid {err.kind} name {json.dumps(err.name)}: {err.reason}{where}"
+
+
+def _toml_error_message(message: str, text: str) -> str:
+    match = _TOML_POSITION.match(message)
+    if match is None:
+        return f"invalid TOML: {message}"
+    reason = match["msg"]
+    if match["line"] is None:
+        line = text.count("\n") + (0 if text.endswith("\n") else 1)
+        return f"line {max(line, 1)}: invalid TOML: {reason} (at the end of the file)"
+    return f"line {match['line']}, column {match['col']}: invalid TOML: {reason}"
+
+
+def _one_line(text: str) -> str:
+    return re.sub(r"\s*\n\s*", " ", text.strip())
