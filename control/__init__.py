@@ -45,6 +45,7 @@ from ._messages import (
 from ._odometry import WheelOdometry, integrate_twist, tick_delta, wrap_angle
 from ._pid import PID
 from ._pure_pursuit import PurePursuit, check_path
+from ._sim_firmware import PtyFirmware, SimulatedFirmware
 from ._smoother import VelocitySmoother
 
 __all__ = [
@@ -81,10 +82,12 @@ __all__ = [
     "parse_packet",
     "PID",
     "PROTOCOL_VERSION",
+    "PtyFirmware",
     "PurePursuit",
     "ResetEncoders",
     "saturate_wheel_speeds",
     "SetWheelVelocities",
+    "SimulatedFirmware",
     "StreamDecoder",
     "tick_delta",
     "VelocitySmoother",
