@@ -1,0 +1,80 @@
+"""The ``aiorobot`` command line.
+
+Subcommands are registered by module path and imported only when invoked, so
+``aiorobot --help`` stays fast (no numpy, numba or rosbags). A command module provides
+``add_arguments(parser)`` and ``main(args) -> int``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from collections.abc import Sequence
+
+from ._parser import ArgumentParser
+
+__all__ = ["COMMANDS", "main"]
+
+#: name -> (module implementing it, one-line help)
+COMMANDS: dict[str, tuple[str, str]] = {
+    "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config (default: the bundled example)"),
+    "bench": ("aiorobot.bench._cli", "executor and transport latency benchmark"),
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``aiorobot`` console script; returns the exit status."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = ArgumentParser(
+        prog="aiorobot",
+        description="aiorobot: asyncio-native robotics, speaking ROS 2's types.",
+    )
+    parser.add_argument("--version", action="version", version=f"aiorobot {_version()}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", title="commands")
+
+    chosen = _chosen_command(argv)
+    module = None
+    if chosen is not None:
+        module_name = COMMANDS[chosen][0]
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as err:
+            if err.name is None or not module_name.startswith(err.name):
+                raise
+            print(
+                f"aiorobot: error: the {chosen!r} command is not available in this installation "
+                f"({module_name} is missing)",
+                file=sys.stderr,
+            )
+            return 2
+    for name, (_, help_text) in COMMANDS.items():
+        sub = subparsers.add_parser(name, help=help_text, description=help_text)
+        if name == chosen and module is not None:
+            module.add_arguments(sub)
+
+    try:
+        args = parser.parse_args(argv)
+        if module is None:
+            parser.error(f"expected a command ({', '.join(COMMANDS)}), found none")
+    except SystemExit as exit_:  # --help, --version and bad arguments
+        return exit_.code if isinstance(exit_.code, int) else 1
+    return int(module.main(args))
+
+
+def _chosen_command(argv: list[str]) -> str | None:
+    """The subcommand named in ``argv``: the first argument that is not an option."""
+    for arg in argv:
+        if arg == "--":
+            return None
+        if not arg.startswith("-"):
+            return arg if arg in COMMANDS else None
+    return None
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("aiorobot")
+    except PackageNotFoundError:  # pragma: no cover - running from a bare checkout
+        return "unknown"
