@@ -11,7 +11,7 @@ from typing import TextIO
 
 from aiorobot._logging import NodeFormatter, parse_level
 
-__all__ = ["configure_logging"]
+__all__ = ["configure_logging", "installed_handler"]
 
 
 class _RichNodeFormatter(logging.Formatter):
@@ -58,3 +58,11 @@ def configure_logging(level: str, stream: TextIO | None = None) -> logging.Handl
     logger.setLevel(parse_level(level))
     logger.propagate = False
     return handler
+
+
+def installed_handler() -> logging.Handler | None:
+    """The handler :func:`configure_logging` installed on the ``aiorobot`` logger, if any."""
+    for handler in logging.getLogger("aiorobot").handlers:
+        if getattr(handler, "_aiorobot_cli", False):
+            return handler
+    return None

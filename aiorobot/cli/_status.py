@@ -28,6 +28,8 @@ class StatusDisplay:
         self._task: asyncio.Task[None] | None = None
         self._start_sec = 0.0
         self._loop: asyncio.AbstractEventLoop | None = None
+        self._log_handler: Any = None
+        self._log_console: Any = None
 
     async def __aenter__(self) -> StatusDisplay:
         self._loop = asyncio.get_running_loop()
@@ -45,6 +47,7 @@ class StatusDisplay:
                 redirect_stderr=True,
             )
             self._live.start()
+            self._share_console_with_log_handler()
         self._task = asyncio.create_task(self._run(), name="aiorobot-status")
         return self
 
@@ -64,7 +67,18 @@ class StatusDisplay:
 
             self._live.update(Text(line), refresh=True)
             self._live.stop()
+            if self._log_handler is not None:
+                self._log_handler.console = self._log_console
         self._write("\n".join(self.summary_lines()))
+
+    def _share_console_with_log_handler(self) -> None:
+        """On one terminal, rich log lines must go through the Live console to land above it."""
+        from ._logging import installed_handler
+
+        handler = installed_handler()
+        if handler is not None and hasattr(handler, "console") and sys.stderr.isatty():
+            self._log_handler, self._log_console = handler, handler.console
+            handler.console = self._live.console
 
     def elapsed_sec(self) -> float:
         return 0.0 if self._loop is None else self._loop.time() - self._start_sec
