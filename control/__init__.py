@@ -45,6 +45,7 @@ from ._messages import (
 from ._odometry import WheelOdometry, integrate_twist, tick_delta, wrap_angle
 from ._pid import PID
 from ._pure_pursuit import PurePursuit, check_path
+from ._serial_link import LinkState, LinkStatistics, SerialLink
 from ._sim_firmware import PtyFirmware, SimulatedFirmware
 from ._smoother import VelocitySmoother
 
@@ -75,6 +76,8 @@ __all__ = [
     "MAX_ENCODED_FRAME_BYTES",
     "MAX_PAYLOAD_BYTES",
     "MAX_WHEELS",
+    "LinkState",
+    "LinkStatistics",
     "Mecanum",
     "Message",
     "MsgId",
@@ -86,6 +89,7 @@ __all__ = [
     "PurePursuit",
     "ResetEncoders",
     "saturate_wheel_speeds",
+    "SerialLink",
     "SetWheelVelocities",
     "SimulatedFirmware",
     "StreamDecoder",

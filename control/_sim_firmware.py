@@ -261,7 +261,7 @@ class PtyFirmware:
         self.bytes_dropped = 0
 
     def __repr__(self) -> str:
-        state = "running" if self._master is not None else "closed"
+        state = "running" if self._task is not None else "open" if self._master is not None else "closed"
         return f"<PtyFirmware {self.port_path or '-'} {state} {self.firmware!r}>"
 
     @property
@@ -269,11 +269,14 @@ class PtyFirmware:
         """The path to open with pyserial: the symlink if one was asked for, else the slave device."""
         return self.link_path or self.slave_path
 
-    async def start(self) -> None:
-        """Open the pty, make the link and start serving."""
+    @property
+    def is_open(self) -> bool:
+        return self._master is not None
+
+    def open(self) -> None:
+        """Create the pty (and the link) now, without serving yet: the port exists from here on."""
         if self._master is not None:
-            raise RuntimeError(f"{self!r} is already running")
-        self._loop = asyncio.get_running_loop()
+            raise RuntimeError(f"{self!r} is already open")
         master, slave = os.openpty()
         tty.setraw(slave)
         os.set_blocking(master, False)
@@ -283,28 +286,57 @@ class PtyFirmware:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(self.link_path)
             os.symlink(self.slave_path, self.link_path)
-        self._loop.add_reader(master, self._on_readable)
+
+    def attach(self, loop: asyncio.AbstractEventLoop | None = None) -> None:
+        """Start receiving: watch the master side on ``loop`` (default: the running loop)."""
+        if self._master is None:
+            self.open()
+        assert self._master is not None
+        if self._loop is None:
+            self._loop = loop if loop is not None else asyncio.get_running_loop()
+            self._loop.add_reader(self._master, self._on_readable)
+
+    def pump(self) -> None:
+        """Integrate the firmware to now and write what it sends; call every ``period_sec``."""
+        out = self.firmware.advance(self._clock())
+        if out and self._master is not None:
+            try:
+                written = os.write(self._master, out)
+                self.bytes_dropped += len(out) - written
+            except OSError:
+                self.bytes_dropped += len(out)  # nobody reading: a UART drops bytes too
+
+    async def start(self) -> None:
+        """Open the pty if needed, then serve it from a task on the running loop."""
+        if self._task is not None:
+            raise RuntimeError(f"{self!r} is already running")
+        self.attach()
         self._task = asyncio.create_task(self._run(), name=f"pty-firmware {self.port_path}")
 
+    def close_pty(self) -> None:
+        """Close the pty (the device disappears) and remove the link; the serving task is not touched."""
+        if self._master is not None:
+            if self._loop is not None:
+                self._loop.remove_reader(self._master)
+            os.close(self._master)
+            self._master = None
+        self._loop = None
+        if self._slave is not None:
+            os.close(self._slave)
+            self._slave = None
+        if self.link_path:
+            with contextlib.suppress(OSError):
+                if os.path.islink(self.link_path) and os.readlink(self.link_path) == self.slave_path:
+                    os.unlink(self.link_path)
+
     async def close(self) -> None:
-        """Stop serving, close the pty (the device disappears) and remove the link."""
+        """Stop serving and close the pty."""
         if self._task is not None:
             self._task.cancel()
             with contextlib.suppress(asyncio.CancelledError):
                 await self._task
             self._task = None
-        if self._master is not None:
-            assert self._loop is not None
-            self._loop.remove_reader(self._master)
-            os.close(self._master)
-            self._master = None
-        if self._slave is not None:
-            os.close(self._slave)
-            self._slave = None
-        if self.link_path:
-            with contextlib.suppress(FileNotFoundError):
-                if os.path.islink(self.link_path) and os.readlink(self.link_path) == self.slave_path:
-                    os.unlink(self.link_path)
+        self.close_pty()
 
     async def __aenter__(self) -> PtyFirmware:
         await self.start()
@@ -328,11 +360,5 @@ class PtyFirmware:
 
     async def _run(self) -> None:
         while True:
-            out = self.firmware.advance(self._clock())
-            if out and self._master is not None:
-                try:
-                    written = os.write(self._master, out)
-                    self.bytes_dropped += len(out) - written
-                except (BlockingIOError, OSError):
-                    self.bytes_dropped += len(out)  # nobody reading: a UART drops bytes too
+            self.pump()
             await asyncio.sleep(self.period_sec)
