@@ -1,0 +1,173 @@
+"""The in-process bus: topics, endpoint matching by type and QoS, transient-local history.
+
+The bus is shared by both loops of a runtime, so registration happens under a
+lock; the publish path reads an immutable tuple of matched subscriptions that
+the bus replaces whenever the matching changes, so it takes no lock.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from ._errors import QoSIncompatibleError
+from ._pubsub import Endpoint, Publisher, Subscription, Tap
+from ._qos import DurabilityPolicy, incompatibility
+
+if TYPE_CHECKING:
+    from ._transport import Transport
+
+__all__ = ["Bus", "Incompatibility"]
+
+_log = logging.getLogger("aiorobot.runtime")
+
+Sub = Subscription | Tap
+
+
+@dataclass(frozen=True, slots=True)
+class Incompatibility:
+    """A publisher/subscription pair on one topic that does not connect, and why."""
+
+    topic: str
+    publisher: str
+    subscription: str
+    reason: str
+
+
+@dataclass
+class _Topic:
+    name: str
+    publishers: list[Publisher] = field(default_factory=list)
+    subscriptions: list[Sub] = field(default_factory=list)
+    incompatible: list[tuple[Publisher, Sub, str]] = field(default_factory=list)
+
+
+class Bus:
+    """Connects the publishers and subscriptions of one runtime."""
+
+    def __init__(self, *, strict_qos: bool = False) -> None:
+        self.strict_qos = strict_qos
+        self._lock = threading.RLock()
+        self._topics: dict[str, _Topic] = {}
+        self.transport: Transport | None = None
+
+    def __repr__(self) -> str:
+        return f"<Bus topics={len(self._topics)} strict_qos={self.strict_qos}>"
+
+    # -- matching -----------------------------------------------------------------
+
+    @staticmethod
+    def _why_not(pub: Publisher, sub: Sub) -> str | None:
+        if pub.type_name != sub.type_name:
+            return f"type: publisher sends {pub.type_name}, subscription expects {sub.type_name}"
+        return incompatibility(pub.qos, sub.qos)
+
+    def _report(self, topic: _Topic, pub: Publisher, sub: Sub, reason: str) -> None:
+        text = (
+            f"incompatible QoS on {topic.name}: {pub.describe()} does not connect to "
+            f"{sub.describe()} ({reason})"
+        )
+        if self.strict_qos:
+            raise QoSIncompatibleError(text)
+        _log.warning(text)
+
+    def _check_strict(self, pairs: list[tuple[Publisher, Sub, str]], topic: _Topic) -> None:
+        if self.strict_qos and pairs:
+            pub, sub, reason = pairs[0]
+            self._report(topic, pub, sub, reason)
+
+    def add_publisher(self, pub: Publisher) -> None:
+        with self._lock:
+            topic = self._topics.setdefault(pub.topic_name, _Topic(pub.topic_name))
+            bad = [(pub, s, r) for s in topic.subscriptions if (r := self._why_not(pub, s))]
+            self._check_strict(bad, topic)
+            topic.publishers.append(pub)
+            for p, s, reason in bad:
+                topic.incompatible.append((p, s, reason))
+                self._report(topic, p, s, reason)
+            self._retarget(topic, pub)
+            if pub._history is not None:
+                for sub in topic.subscriptions:
+                    if sub not in pub._subs:
+                        continue
+                    if sub.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL:
+                        self._replay(pub, sub)
+        self._notify_added(pub)
+
+    def add_subscription(self, sub: Sub) -> None:
+        with self._lock:
+            topic = self._topics.setdefault(sub.topic_name, _Topic(sub.topic_name))
+            bad = [(p, sub, r) for p in topic.publishers if (r := self._why_not(p, sub))]
+            self._check_strict(bad, topic)
+            topic.subscriptions.append(sub)
+            for p, s, reason in bad:
+                topic.incompatible.append((p, s, reason))
+                self._report(topic, p, s, reason)
+            for pub in topic.publishers:
+                self._retarget(topic, pub)
+                if (
+                    sub in pub._subs
+                    and pub._history is not None
+                    and sub.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL
+                ):
+                    self._replay(pub, sub)
+        self._notify_added(sub)
+
+    def remove(self, endpoint: Endpoint) -> None:
+        with self._lock:
+            topic = self._topics.get(endpoint.topic_name)
+            if topic is None:
+                return
+            if isinstance(endpoint, Publisher):
+                if endpoint in topic.publishers:
+                    topic.publishers.remove(endpoint)
+                endpoint._set_targets(())
+            elif endpoint in topic.subscriptions:
+                topic.subscriptions.remove(endpoint)  # type: ignore[arg-type]
+            topic.incompatible = [
+                (p, s, r) for p, s, r in topic.incompatible if p is not endpoint and s is not endpoint
+            ]
+            for pub in topic.publishers:
+                self._retarget(topic, pub)
+            if not topic.publishers and not topic.subscriptions:
+                del self._topics[topic.name]
+        if self.transport is not None:
+            self.transport.endpoint_removed(endpoint)
+
+    def _notify_added(self, endpoint: Endpoint) -> None:
+        if self.transport is not None:
+            self.transport.endpoint_added(endpoint)
+
+    def _retarget(self, topic: _Topic, pub: Publisher) -> None:
+        bad = {id(s) for p, s, _ in topic.incompatible if p is pub}
+        pub._set_targets(tuple(s for s in topic.subscriptions if id(s) not in bad))
+
+    @staticmethod
+    def _replay(pub: Publisher, sub: Sub) -> None:
+        """Hand a late-joining transient-local subscription the publisher's history, in order."""
+        assert pub._history is not None
+        for msg in list(pub._history):
+            if isinstance(sub, Tap):
+                sub._enqueue(msg)
+            else:
+                sub.node._call_soon(sub._enqueue, msg)
+
+    # -- introspection --------------------------------------------------------------
+
+    def snapshot(self) -> list[_Topic]:
+        """A consistent copy of every topic's endpoints (for ``Runtime.graph``)."""
+        with self._lock:
+            return [
+                _Topic(t.name, list(t.publishers), list(t.subscriptions), list(t.incompatible))
+                for t in sorted(self._topics.values(), key=lambda t: t.name)
+            ]
+
+    def incompatibilities(self) -> list[Incompatibility]:
+        with self._lock:
+            return [
+                Incompatibility(t.name, p.describe(), s.describe(), r)
+                for t in self._topics.values()
+                for p, s, r in t.incompatible
+            ]

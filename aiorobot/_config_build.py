@@ -1,0 +1,226 @@
+"""The building half of the config loader: import node classes and construct the nodes.
+
+:func:`build_nodes` turns a validated :class:`~aiorobot._config.GraphConfig` into node
+objects, checking everything that needs the classes themselves (importable module and
+class, an ``aiorobot.Node`` subclass, declared and well-typed parameters, unique names)
+before anything is started. Problems raise :class:`~aiorobot._config.ConfigError`.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+import inspect
+import pkgutil
+import sys
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
+from ._config import ConfigError, GraphConfig, NodeConfig
+from ._errors import InvalidParameterValueError
+
+if TYPE_CHECKING:
+    from aiorobot import Node
+
+__all__ = ["build_nodes", "import_node_class"]
+
+
+def build_nodes(config: GraphConfig) -> list[tuple[Node, str]]:
+    """Construct every node of ``config`` (nothing is started).
+
+    The folder holding the config file is put on ``sys.path`` (first) so that
+    ``use = "my_nodes:Talker"`` finds ``my_nodes.py`` beside the file.
+
+    Returns
+    -------
+    list of (Node, str)
+        Each node with its executor name (``"main"`` or ``"priority"``), in file order.
+
+    Raises
+    ------
+    ConfigError
+        The first problem found; no node has been added to any runtime.
+    """
+    base_dir = str(config.base_dir)
+    if base_dir not in sys.path:
+        sys.path.insert(0, base_dir)
+    built: list[tuple[Node, str]] = []
+    owners: dict[str, int] = {}
+    for node_config in config.nodes:
+        node = _construct(config, node_config)
+        fqn = node.get_fully_qualified_name()
+        if fqn in owners:
+            raise ConfigError(
+                config.path,
+                f"{node_config.key}.name",
+                f'expected a unique node name, found "{fqn}" again (nodes[{owners[fqn]}] is '
+                f"already called that); set a different name or namespace",
+            )
+        owners[fqn] = node_config.index
+        built.append((node, node_config.executor))
+    return built
+
+
+def import_node_class(config: GraphConfig, node_config: NodeConfig) -> type[Node]:
+    """Import the class named by ``node_config.use`` and check that it is a Node subclass."""
+    from aiorobot import Node
+
+    key = f"{node_config.key}.use"
+    module = _import_module(config, key, node_config.module_name)
+    target: Any = module
+    for part in node_config.class_name.split("."):
+        if not hasattr(target, part):
+            candidates = [n for n in dir(target) if not n.startswith("_")]
+            nodes = [n for n in candidates if _is_node_class(getattr(target, n, None), Node)]
+            close = difflib.get_close_matches(part, nodes, n=1) or difflib.get_close_matches(
+                part, candidates, n=1
+            )
+            hint = f' (did you mean "{close[0]}"?)' if close else ""
+            owner = f'module "{node_config.module_name}"' if target is module else f'"{target.__qualname__}"'
+            raise ConfigError(config.path, key, f'{owner} has no class "{part}"{hint}')
+        target = getattr(target, part)
+    if not _is_node_class(target, Node):
+        if inspect.isclass(target):
+            kind = "a class not derived from aiorobot.Node"
+        else:
+            kind = f"a {type(target).__name__}"
+        raise ConfigError(
+            config.path,
+            key,
+            f'expected an aiorobot.Node subclass, found "{node_config.use}" ({kind})',
+        )
+    return target
+
+
+def _import_module(config: GraphConfig, key: str, module_name: str) -> ModuleType:
+    try:
+        return importlib.import_module(module_name)
+    except ModuleNotFoundError as err:
+        missing = err.name or ""
+        if missing and (module_name == missing or module_name.startswith(missing + ".")):
+            raise ConfigError(
+                config.path, key, _module_not_found(module_name, missing, config)
+            ) from None
+        raise ConfigError(
+            config.path, key, f'importing module "{module_name}" failed: {_describe(err)}'
+        ) from None
+    except Exception as err:  # the user's module raised while being imported
+        raise ConfigError(
+            config.path, key, f'importing module "{module_name}" failed: {_describe(err)}'
+        ) from None
+
+
+def _module_not_found(module_name: str, missing: str, config: GraphConfig) -> str:
+    parent, _, leaf = missing.rpartition(".")
+    siblings: list[str] = []
+    if not parent:  # a top-level module: suggest from the config's folder
+        siblings = [m.name for m in pkgutil.iter_modules([str(config.base_dir)])]
+    else:
+        try:
+            package = importlib.import_module(parent)
+            siblings = [m.name for m in pkgutil.iter_modules(getattr(package, "__path__", []))]
+        except Exception:  # noqa: BLE001 - a suggestion is a nicety, never an error
+            siblings = []
+    close = difflib.get_close_matches(leaf, siblings, n=1)
+    hint = f' (did you mean "{parent}.{close[0]}"?)' if close else ""
+    where = "" if missing != module_name else f" on the Python path or in {config.base_dir}"
+    found = f'module "{module_name}" was not found' if missing == module_name else (
+        f'module "{module_name}" was not found: there is no "{missing}"'
+    )
+    return f"expected an importable module{where}, but {found}{hint}"
+
+
+def _construct(config: GraphConfig, node_config: NodeConfig) -> Node:
+    cls = import_node_class(config, node_config)
+    kwargs: dict[str, Any] = {}
+    if node_config.parameters:
+        kwargs["parameter_overrides"] = {
+            name: list(value) if isinstance(value, tuple) else value
+            for name, value in node_config.parameters.items()
+        }
+    remappings: dict[str, str] = {}
+    if node_config.name is not None:
+        remappings["__node"] = node_config.name
+    if node_config.namespace is not None:
+        remappings["__ns"] = node_config.namespace
+    remappings.update(node_config.remap)
+    if remappings:
+        kwargs["remappings"] = remappings
+    _check_signature(config, node_config, cls, kwargs)
+    try:
+        node = cls(**kwargs)
+    except InvalidParameterValueError as err:
+        raise ConfigError(
+            config.path, _parameter_key(node_config, err.name), err.reason
+        ) from None
+    except Exception as err:  # noqa: BLE001 - any constructor failure is a config problem
+        raise ConfigError(
+            config.path,
+            node_config.key,
+            f'constructing "{node_config.use}" failed: {_describe(err)}',
+        ) from None
+    unclaimed = sorted(node.unclaimed_parameter_overrides())
+    if unclaimed:
+        name = unclaimed[0]
+        declared = _declared_parameters(node)
+        close = difflib.get_close_matches(name, declared, n=1)
+        hint = f' (did you mean "{close[0]}"?)' if close else ""
+        known = f"; it declares: {', '.join(declared)}" if declared else "; it declares none"
+        raise ConfigError(
+            config.path,
+            _parameter_key(node_config, name),
+            f'expected a parameter declared by node "{node.get_fully_qualified_name()}" '
+            f"({cls.__name__}), found an undeclared one{hint}{known}",
+        )
+    if node_config.log_level is not None:
+        node.get_logger().set_level(node_config.log_level)
+    return node
+
+
+def _check_signature(
+    config: GraphConfig, node_config: NodeConfig, cls: type, kwargs: dict[str, Any]
+) -> None:
+    """A class whose ``__init__`` cannot take the keywords gets a hint on how to write it."""
+    if not kwargs:
+        return
+    try:
+        signature = inspect.signature(cls)
+    except (TypeError, ValueError):
+        return
+    params = signature.parameters.values()
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params):
+        return
+    missing = [k for k in kwargs if k not in signature.parameters]
+    if missing:
+        raise ConfigError(
+            config.path,
+            node_config.key,
+            f"expected {cls.__name__}.__init__ to accept {' and '.join(missing)} (write "
+            f'"def __init__(self, **kw): super().__init__("name", **kw)"), found '
+            f"{cls.__name__}{signature}",
+        )
+
+
+def _declared_parameters(node: Node) -> list[str]:
+    lister = getattr(node, "list_parameters", None)
+    if lister is None:
+        return []
+    try:
+        names = lister()
+    except Exception:  # noqa: BLE001 - a suggestion is a nicety
+        return []
+    names = getattr(names, "names", names)
+    return sorted(str(n) for n in names)
+
+
+def _parameter_key(node_config: NodeConfig, name: str) -> str:
+    return f"{node_config.key}.parameters.{name}"
+
+
+def _is_node_class(obj: Any, node_base: type) -> bool:
+    return inspect.isclass(obj) and issubclass(obj, node_base)
+
+
+def _describe(err: BaseException) -> str:
+    text = str(err)
+    return f"{type(err).__name__}: {text}" if text else type(err).__name__

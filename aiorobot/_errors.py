@@ -1,0 +1,62 @@
+"""Exceptions raised by the aiorobot core."""
+
+from __future__ import annotations
+
+__all__ = [
+    "InvalidNameError",
+    "InvalidParameterValueError",
+    "ParameterAlreadyDeclaredError",
+    "ParameterError",
+    "ParameterNotDeclaredError",
+    "QoSIncompatibleError",
+    "ServiceError",
+]
+
+
+class InvalidNameError(ValueError):
+    """A topic, service, node or namespace name breaks ROS 2's naming rules.
+
+    The message quotes the name and points a caret at the offending character.
+    """
+
+    def __init__(self, kind: str, name: str, reason: str, index: int | None = None) -> None:
+        self.kind = kind
+        self.name = name
+        self.reason = reason
+        self.index = index
+        text = f"invalid {kind} name {name!r}: {reason}"
+        if index is not None:
+            text += f"\n  {name}\n  {' ' * index}^"
+        super().__init__(text)
+
+
+class QoSIncompatibleError(RuntimeError):
+    """A publisher and a subscription on one topic have incompatible QoS policies."""
+
+
+class ParameterError(ValueError):
+    """Base class of parameter errors."""
+
+
+class ParameterNotDeclaredError(ParameterError, KeyError):
+    """A parameter was read or set before ``declare_parameter``."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0])
+
+
+class ParameterAlreadyDeclaredError(ParameterError):
+    """``declare_parameter`` was called twice for one name."""
+
+
+class InvalidParameterValueError(ParameterError):
+    """A value (override or default) has the wrong type or lies outside the range."""
+
+    def __init__(self, name: str, reason: str) -> None:
+        self.name = name
+        self.reason = reason
+        super().__init__(f"parameter {name!r}: {reason}")
+
+
+class ServiceError(RuntimeError):
+    """A service call failed on the server side; the message carries the server's reason."""

@@ -1,0 +1,477 @@
+"""``Node``: the unit users write. Entity factories, parameters, logging, clock, offloading.
+
+A node can be built before it joins a runtime (entities created in ``__init__``
+wait); ``Runtime.add_node`` binds it to a loop — the main loop or the priority
+loop — registers its endpoints on the bus and starts its timers and dispatchers
+there. Every callback may be ``async def`` or ``def``; it runs under its callback
+group, and an exception it raises is logged with the node and entity named while
+the node goes on.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import functools
+import inspect
+import threading
+from collections.abc import Awaitable, Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, TypeVar
+
+from ._clock import Clock
+from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
+from ._logging import NodeLogger
+from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
+from ._parameters import (
+    OnSetCallback,
+    Parameter,
+    ParameterDescriptor,
+    ParameterStore,
+    SetParametersResult,
+)
+from ._pubsub import MessageStream, Publisher, Subscription
+from ._qos import QoSProfile, to_qos_profile
+from ._time import Time
+from ._timer import Rate, Timer
+from ._waker import LoopWaker, TimerFdWaker
+
+if TYPE_CHECKING:
+    from ._runtime import Runtime
+
+__all__ = ["Node"]
+
+M = TypeVar("M")
+R = TypeVar("R")
+
+
+class Node:
+    """A ROS 2 style node, asyncio-native.
+
+    Parameters
+    ----------
+    name
+        The node name (letters, digits, ``_``); a ``__node`` remapping overrides it.
+    namespace
+        The node's namespace (``"/robot1"``); a ``__ns`` remapping overrides it.
+    parameter_overrides
+        Values that replace the defaults of parameters this node declares.
+    remappings
+        Topic and service remappings (``{"/cmd_vel": "/base/cmd_vel"}``), plus the
+        special keys ``__node`` and ``__ns`` as in ROS 2.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        *,
+        namespace: str = "",
+        parameter_overrides: Mapping[str, Any] | None = None,
+        remappings: Mapping[str, str] | None = None,
+    ) -> None:
+        remaps = dict(remappings or {})
+        for key, value in remaps.items():
+            if not isinstance(key, str) or not isinstance(value, str):
+                raise TypeError(f"remappings: expected str -> str, found {key!r} -> {value!r}")
+        self._name = validate_node_name(remaps.get("__node", name))
+        self._namespace = validate_namespace(remaps.get("__ns", namespace))
+        self._remappings = remaps
+        self._fqn = join_fqn(self._namespace, self._name)
+        self._parameters = ParameterStore(self._fqn, dict(parameter_overrides or {}))
+        self._logger = NodeLogger(self._fqn)
+        self._default_group = MutuallyExclusiveCallbackGroup()
+        self._publishers: list[Publisher[Any]] = []
+        self._subscriptions: list[Subscription[Any]] = []
+        self._timers: list[Timer] = []
+        self._tasks: set[asyncio.Task[Any]] = set()
+        # Bound by Runtime.add_node:
+        self._runtime: Runtime | None = None
+        self._executor: str | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread_id: int | None = None
+        self._waker: LoopWaker | TimerFdWaker | None = None
+        self._clock: Clock = Clock()
+        self._started = False
+
+    def __repr__(self) -> str:
+        where = f" on {self._executor}" if self._executor else " (not added)"
+        return f"<{type(self).__name__} {self._fqn}{where}>"
+
+    # -- identity ----------------------------------------------------------------
+
+    def get_name(self) -> str:
+        return self._name
+
+    def get_namespace(self) -> str:
+        return self._namespace
+
+    def get_fully_qualified_name(self) -> str:
+        return self._fqn
+
+    @property
+    def executor(self) -> str | None:
+        """``"main"`` or ``"priority"`` once added to a runtime."""
+        return self._executor
+
+    @property
+    def runtime(self) -> Runtime:
+        if self._runtime is None:
+            raise RuntimeError(f"{self!r} is not added to a runtime; call runtime.add_node(node) first")
+        return self._runtime
+
+    def resolve_topic_name(self, topic: str, *, kind: str = "topic") -> str:
+        """The fully qualified, remapped name ``topic`` refers to from this node."""
+        return resolve_name(topic, self._name, self._namespace, self._remappings, kind)
+
+    # -- lifecycle hooks -------------------------------------------------------------
+
+    async def on_start(self) -> None:
+        """Called on the node's loop once it runs (open devices, start background work)."""
+
+    async def on_shutdown(self) -> None:
+        """Called once when the runtime shuts down, before anything stops.
+
+        Controllers command zero velocity here; what is published still reaches
+        subscribers on either loop before the runtime stops.
+        """
+
+    # -- entities ---------------------------------------------------------------------
+
+    def create_publisher(self, msg_type: type[M], topic: str, qos: QoSProfile | int) -> Publisher[M]:
+        pub: Publisher[M] = Publisher(self, msg_type, self.resolve_topic_name(topic), to_qos_profile(qos))
+        _check_msg_type(msg_type)
+        self._publishers.append(pub)
+        if self._runtime is not None:
+            try:
+                self._runtime._bus.add_publisher(pub)
+            except BaseException:
+                self._publishers.remove(pub)
+                raise
+        return pub
+
+    def create_subscription(
+        self,
+        msg_type: type[M],
+        topic: str,
+        callback: Callable[[M], Any],
+        qos: QoSProfile | int,
+        *,
+        callback_group: CallbackGroup | None = None,
+    ) -> Subscription[M]:
+        if not callable(callback):
+            raise TypeError(f"subscription callback must be callable, got {callback!r}")
+        return self._add_subscription(msg_type, topic, callback, qos, callback_group)
+
+    def subscribe(self, msg_type: type[M], topic: str, qos: QoSProfile | int = 10) -> MessageStream[M]:
+        """Receive a topic as an async iterator: ``async for msg in node.subscribe(T, "/x")``."""
+        return MessageStream(self._add_subscription(msg_type, topic, None, qos, None))
+
+    def _add_subscription(
+        self,
+        msg_type: type[M],
+        topic: str,
+        callback: Callable[[M], Any] | None,
+        qos: QoSProfile | int,
+        group: CallbackGroup | None,
+    ) -> Subscription[M]:
+        _check_msg_type(msg_type)
+        sub: Subscription[M] = Subscription(
+            self,
+            msg_type,
+            self.resolve_topic_name(topic),
+            callback,
+            to_qos_profile(qos),
+            group or self._default_group,
+        )
+        self._subscriptions.append(sub)
+        if self._runtime is not None:
+            try:
+                self._runtime._bus.add_subscription(sub)
+            except BaseException:
+                self._subscriptions.remove(sub)
+                raise
+            if self._started:
+                self._call_soon(sub._start)
+        return sub
+
+    def create_timer(
+        self,
+        period_sec: float,
+        callback: Callable[[], Any],
+        *,
+        callback_group: CallbackGroup | None = None,
+        autostart: bool = True,
+    ) -> Timer:
+        if not callable(callback):
+            raise TypeError(f"timer callback must be callable, got {callback!r}")
+        timer = Timer(self, period_sec, callback, callback_group or self._default_group, autostart=autostart)
+        self._timers.append(timer)
+        if self._started and autostart:
+            self._call_soon(timer._start)
+        return timer
+
+    def create_rate(self, frequency: float) -> Rate:
+        return Rate(self, frequency)
+
+    def destroy_publisher(self, pub: Publisher[Any]) -> None:
+        if pub in self._publishers:
+            self._publishers.remove(pub)
+            pub.destroyed = True
+            if self._runtime is not None:
+                self._runtime._bus.remove(pub)
+
+    def destroy_subscription(self, sub: Subscription[Any]) -> None:
+        if sub in self._subscriptions:
+            self._subscriptions.remove(sub)
+            if self._runtime is not None:
+                self._runtime._bus.remove(sub)
+            self._call_soon(self._close_subscription, sub)
+
+    @staticmethod
+    def _close_subscription(sub: Subscription[Any]) -> None:
+        sub.destroyed = True
+        if sub._task is not None:
+            sub._task.cancel()
+        waiter = sub._waiter
+        if waiter is not None and not waiter.done():
+            waiter.set_result(None)
+
+    def destroy_timer(self, timer: Timer) -> None:
+        if timer in self._timers:
+            self._timers.remove(timer)
+            timer.destroyed = True
+            timer._cancelled = True
+            self._call_soon(self._close_timer, timer)
+
+    @staticmethod
+    def _close_timer(timer: Timer) -> None:
+        if timer._task is not None:
+            timer._task.cancel()
+
+    @property
+    def publishers(self) -> tuple[Publisher[Any], ...]:
+        return tuple(self._publishers)
+
+    @property
+    def subscriptions(self) -> tuple[Subscription[Any], ...]:
+        return tuple(self._subscriptions)
+
+    @property
+    def timers(self) -> tuple[Timer, ...]:
+        return tuple(self._timers)
+
+    # -- parameters ---------------------------------------------------------------------
+
+    def declare_parameter(
+        self,
+        name: str,
+        default: Any = None,
+        *,
+        description: str = "",
+        read_only: bool = False,
+        range: Iterable[float] | None = None,
+    ) -> Parameter:
+        """Declare a parameter; an override given to the node replaces ``default``.
+
+        Raises ``InvalidParameterValueError`` when the override has the wrong type
+        or lies outside ``range`` (``(from, to)`` or ``(from, to, step)``).
+        """
+        return self._parameters.declare(
+            name,
+            default,
+            description=description,
+            read_only=read_only,
+            range=tuple(range) if range is not None else None,
+        )
+
+    def declare_parameters(self, values: Mapping[str, Any]) -> list[Parameter]:
+        return [self.declare_parameter(name, value) for name, value in values.items()]
+
+    def has_parameter(self, name: str) -> bool:
+        return self._parameters.has(name)
+
+    def get_parameter(self, name: str) -> Parameter:
+        return self._parameters.get(name)
+
+    def get_parameters(self, names: Iterable[str]) -> list[Parameter]:
+        return [self._parameters.get(n) for n in names]
+
+    def describe_parameter(self, name: str) -> ParameterDescriptor:
+        return self._parameters.describe(name)
+
+    def list_parameters(self) -> list[str]:
+        return self._parameters.names()
+
+    def set_parameters(self, parameters: Iterable[Parameter]) -> list[SetParametersResult]:
+        """Set each parameter; one result per parameter saying whether and why not."""
+        return self._parameters.set(parameters)
+
+    async def set_parameters_async(self, parameters: Iterable[Parameter]) -> list[SetParametersResult]:
+        """As :meth:`set_parameters`, awaiting ``async def`` on-set callbacks."""
+        return await self._parameters.set_async(parameters)
+
+    def add_on_set_parameters_callback(self, callback: OnSetCallback) -> OnSetCallback:
+        """``callback(params) -> SetParametersResult`` vets every change before it applies."""
+        return self._parameters.add_callback(callback)
+
+    def remove_on_set_parameters_callback(self, callback: OnSetCallback) -> None:
+        self._parameters.remove_callback(callback)
+
+    def unclaimed_parameter_overrides(self) -> list[str]:
+        """Overrides given to the node for parameters it never declared."""
+        return self._parameters.unclaimed_overrides()
+
+    # -- logging and time -----------------------------------------------------------------
+
+    def get_logger(self) -> NodeLogger:
+        return self._logger
+
+    def get_clock(self) -> Clock:
+        return self._clock
+
+    def now(self) -> Time:
+        return self._clock.now()
+
+    # -- work elsewhere -------------------------------------------------------------------
+
+    async def offload(self, fn: Callable[..., R], *args: Any, **kwargs: Any) -> R:
+        """Run a picklable ``fn(*args, **kwargs)`` in the runtime's process pool."""
+        pool = self.runtime._process_pool()
+        return await asyncio.get_running_loop().run_in_executor(pool, functools.partial(fn, *args, **kwargs))
+
+    async def run_in_thread(self, fn: Callable[..., R], *args: Any, **kwargs: Any) -> R:
+        """Run ``fn`` in the runtime's thread pool: for kernels that release the GIL (OpenCV, Numba)."""
+        pool = self.runtime._thread_pool()
+        return await asyncio.get_running_loop().run_in_executor(pool, functools.partial(fn, *args, **kwargs))
+
+    # -- graph queries --------------------------------------------------------------------
+
+    def count_publishers(self, topic: str) -> int:
+        return len(self.runtime.graph.publishers_of(self.resolve_topic_name(topic)))
+
+    def count_subscribers(self, topic: str) -> int:
+        return len(self.runtime.graph.subscriptions_of(self.resolve_topic_name(topic)))
+
+    def get_topic_names_and_types(self) -> list[tuple[str, list[str]]]:
+        return [(t.name, list(t.types)) for t in self.runtime.graph.topics]
+
+    # -- runtime plumbing (private) ----------------------------------------------------------
+
+    def _bind(
+        self,
+        runtime: Runtime,
+        executor: str,
+        loop: asyncio.AbstractEventLoop,
+        thread_id: int,
+        waker: LoopWaker | TimerFdWaker,
+    ) -> None:
+        self._runtime = runtime
+        self._executor = executor
+        self._loop = loop
+        self._thread_id = thread_id
+        self._waker = waker
+        self._clock = runtime.clock
+        self._logger._bind_clock(runtime.clock)
+
+    def _unbind(self) -> None:
+        self._runtime = None
+        self._executor = None
+        self._loop = None
+        self._thread_id = None
+        self._waker = None
+        self._started = False
+
+    def _call_soon(self, fn: Callable[..., Any], *args: Any) -> None:
+        """Run ``fn(*args)`` on this node's loop: now if we are on it, else thread-safely."""
+        loop = self._loop
+        if loop is None:
+            fn(*args)
+        elif threading.get_ident() == self._thread_id:
+            fn(*args)
+        elif not loop.is_closed():
+            loop.call_soon_threadsafe(fn, *args)
+
+    def _create_task(self, coro: Awaitable[Any], *, name: str | None = None) -> asyncio.Task[Any]:
+        assert self._loop is not None
+        task = self._loop.create_task(coro, name=name)  # type: ignore[arg-type]
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+        return task
+
+    def _start(self) -> None:
+        """Start dispatchers and timers (on the node's loop), then ``on_start``."""
+        if self._started:
+            return
+        self._started = True
+        for sub in self._subscriptions:
+            sub._start()
+        for timer in self._timers:
+            if not timer._cancelled:
+                timer._start()
+        self._create_task(self._run_hook(self.on_start, "on_start"), name=f"on_start {self._fqn}")
+
+    async def _run_hook(self, hook: Callable[[], Any], what: str) -> None:
+        try:
+            result = hook()
+            if inspect.isawaitable(result):
+                await result
+        except asyncio.CancelledError:
+            raise
+        except Exception:
+            self._logger.error(f"{what} of {self._fqn} raised", exc_info=True)
+
+    async def _stop(self) -> None:
+        """Cancel every task of this node and wait for them (on the node's loop)."""
+        for sub in list(self._subscriptions):
+            self._close_subscription(sub)
+        current = asyncio.current_task()
+        tasks = [t for t in self._tasks if t is not current]
+        for task in tasks:
+            task.cancel()
+        if tasks:
+            await asyncio.gather(*tasks, return_exceptions=True)
+        self._started = False
+
+    def _idle(self) -> bool:
+        return all(sub.is_idle() for sub in self._subscriptions)
+
+    async def _invoke(
+        self,
+        entity: Any,
+        group: CallbackGroup,
+        fn: Callable[..., Any],
+        *args: Any,
+        start_deadline: int | None = None,
+    ) -> Any:
+        """Run one callback under its group; log (never raise) what it raises."""
+        try:
+            if group.exclusive:
+                async with group:
+                    if start_deadline is not None:
+                        entity._record_start(start_deadline)
+                    result = fn(*args)
+                    if result is not None and inspect.isawaitable(result):
+                        return await result
+                    return result
+            if start_deadline is not None:
+                entity._record_start(start_deadline)
+            result = fn(*args)
+            if result is not None and inspect.isawaitable(result):
+                return await result
+            return result
+        except asyncio.CancelledError:
+            raise
+        except Exception:
+            self._logger.error(f"callback of {_describe(entity)} in {self._fqn} raised", exc_info=True)
+            return None
+
+
+def _describe(entity: Any) -> str:
+    if isinstance(entity, Subscription):
+        return f"subscription {entity.topic_name}"
+    if isinstance(entity, Timer):
+        return f"timer {entity.period_ns / 1e9:g}s"
+    return repr(entity)
+
+
+def _check_msg_type(msg_type: Any) -> None:
+    if not isinstance(msg_type, type):
+        raise TypeError(f"expected a message class (e.g. aiorobot.msgs.geometry_msgs.Twist), got {msg_type!r}")

@@ -1,0 +1,307 @@
+"""Publishers and subscriptions of the in-process bus.
+
+Delivery is zero-copy: every subscription receives the very object that was
+published, so a publisher must not mutate a message after ``publish``.
+A subscription owns a queue bounded by its QoS history (KEEP_LAST drops the
+oldest when full) and one dispatcher task on its node's loop; messages from
+another loop arrive through ``call_soon_threadsafe``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+from collections import deque
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
+
+from ._qos import DurabilityPolicy, QoSProfile
+
+if TYPE_CHECKING:
+    from ._groups import CallbackGroup
+    from ._node import Node
+
+__all__ = ["Endpoint", "MessageStream", "Publisher", "Subscription", "Tap"]
+
+M = TypeVar("M")
+
+#: Messages a dispatcher handles before yielding to the loop when callbacks never suspend.
+_BATCH = 64
+
+
+def _type_name(msg_type: Any) -> str:
+    return getattr(msg_type, "__msgtype__", None) or getattr(msg_type, "__name__", repr(msg_type))
+
+
+class Endpoint:
+    """Something attached to a topic name: a publisher, subscription or tap."""
+
+    kind = "endpoint"
+
+    def __init__(self, node: Node | None, msg_type: Any, topic: str, qos: QoSProfile) -> None:
+        self.node = node
+        self.msg_type = msg_type
+        self.topic_name = topic
+        self.qos = qos
+        self.destroyed = False
+
+    @property
+    def type_name(self) -> str:
+        return _type_name(self.msg_type)
+
+    @property
+    def node_name(self) -> str:
+        return self.node.get_fully_qualified_name() if self.node is not None else "<runtime>"
+
+    def describe(self) -> str:
+        return f"{self.kind} of {self.node_name} on {self.topic_name} [{self.type_name}, {self.qos.short()}]"
+
+
+class Publisher(Endpoint, Generic[M]):
+    """Publishes messages of one type on one topic; created by ``Node.create_publisher``."""
+
+    kind = "publisher"
+
+    def __init__(self, node: Node, msg_type: type[M], topic: str, qos: QoSProfile) -> None:
+        super().__init__(node, msg_type, topic, qos)
+        self._history: deque[Any] | None = (
+            deque(maxlen=qos.depth) if qos.durability is DurabilityPolicy.TRANSIENT_LOCAL else None
+        )
+        self._subs: tuple[Subscription | Tap, ...] = ()
+        self._same_loop: tuple[Subscription, ...] = ()
+        self._other_loops: tuple[tuple[asyncio.AbstractEventLoop, tuple[Subscription, ...]], ...] = ()
+        self._taps: tuple[Tap, ...] = ()
+        self._thread_id: int | None = None
+        self.published = 0
+
+    def __repr__(self) -> str:
+        return (
+            f"<Publisher {self.topic_name} {self.type_name} depth={self.qos.depth} "
+            f"subscriptions={self.get_subscription_count()}>"
+        )
+
+    def get_subscription_count(self) -> int:
+        """How many subscriptions (in this process and, with a transport, remote) receive this publisher."""
+        return len(self._subs)
+
+    def _set_targets(self, subs: tuple[Subscription | Tap, ...]) -> None:
+        """Install the matched subscriptions (called by the bus under its lock)."""
+        own_loop = self.node._loop if self.node is not None else None
+        self._thread_id = self.node._thread_id if self.node is not None else None
+        same: list[Subscription] = []
+        other: dict[asyncio.AbstractEventLoop, list[Subscription]] = {}
+        taps: list[Tap] = []
+        for sub in subs:
+            if isinstance(sub, Tap):
+                taps.append(sub)
+            elif sub.node._loop is own_loop:
+                same.append(sub)
+            else:
+                other.setdefault(sub.node._loop, []).append(sub)
+        self._subs = subs
+        self._same_loop = tuple(same)
+        self._other_loops = tuple((loop, tuple(group)) for loop, group in other.items())
+        self._taps = tuple(taps)
+
+    def publish(self, msg: M) -> None:
+        """Hand ``msg`` to every matched subscription. Do not mutate ``msg`` afterwards."""
+        if not isinstance(msg, self.msg_type):
+            raise TypeError(
+                f"publisher on {self.topic_name} expects {self.type_name}, got {type(msg).__name__}: {msg!r}"
+            )
+        if self.destroyed:
+            raise RuntimeError(f"{self!r} was destroyed")
+        self.published += 1
+        if self._history is not None:
+            self._history.append(msg)
+        if threading.get_ident() == self._thread_id:
+            for sub in self._same_loop:
+                sub._enqueue(msg)
+            for loop, subs in self._other_loops:
+                _call_threadsafe(loop, _enqueue_all, subs, msg)
+        else:
+            for sub in self._same_loop:
+                _call_threadsafe(sub.node._loop, sub._enqueue, msg)
+            for loop, subs in self._other_loops:
+                _call_threadsafe(loop, _enqueue_all, subs, msg)
+        for tap in self._taps:
+            tap._enqueue(msg)
+
+    def destroy(self) -> None:
+        if self.node is not None:
+            self.node.destroy_publisher(self)
+
+
+def _enqueue_all(subs: tuple[Subscription, ...], msg: Any) -> None:
+    for sub in subs:
+        sub._enqueue(msg)
+
+
+def _call_threadsafe(loop: asyncio.AbstractEventLoop, fn: Callable[..., Any], *args: Any) -> None:
+    try:
+        loop.call_soon_threadsafe(fn, *args)
+    except RuntimeError:  # the loop closed during shutdown: nobody is left to receive
+        pass
+
+
+class Tap(Endpoint):
+    """A subscription whose callback runs synchronously in the publishing thread.
+
+    Used by the runtime (``/clock``) and by transports and recorders, which must see
+    every message in publish order without a queue. The callback must be quick and
+    thread-safe.
+    """
+
+    kind = "subscription"
+
+    def __init__(self, msg_type: Any, topic: str, qos: QoSProfile, callback: Callable[[Any], None], *, owner: str = "<runtime>") -> None:
+        super().__init__(None, msg_type, topic, qos)
+        self._enqueue = callback
+        self.owner = owner
+
+    @property
+    def node_name(self) -> str:
+        return self.owner
+
+    def __repr__(self) -> str:
+        return f"<Tap {self.topic_name} {self.type_name} owner={self.owner}>"
+
+
+class Subscription(Endpoint, Generic[M]):
+    """Receives messages of one topic into a QoS-bounded queue; a dispatcher runs the callback."""
+
+    kind = "subscription"
+
+    def __init__(
+        self,
+        node: Node,
+        msg_type: type[M],
+        topic: str,
+        callback: Callable[[M], Any] | None,
+        qos: QoSProfile,
+        group: CallbackGroup,
+    ) -> None:
+        super().__init__(node, msg_type, topic, qos)
+        self.callback = callback
+        self.callback_group = group
+        self._queue: deque[Any] = deque()
+        self._limit = qos.queue_limit
+        self._waiter: asyncio.Future[None] | None = None
+        self._task: asyncio.Task[None] | None = None
+        self._busy = 0
+        self.received = 0
+        self.dropped = 0
+
+    def __repr__(self) -> str:
+        return (
+            f"<Subscription {self.topic_name} {self.type_name} depth={self.qos.depth} "
+            f"queued={len(self._queue)}>"
+        )
+
+    @property
+    def queued(self) -> int:
+        return len(self._queue)
+
+    def is_idle(self) -> bool:
+        return not self._queue and self._busy == 0
+
+    def _enqueue(self, msg: Any) -> None:
+        """Put ``msg`` into the queue (on the node's loop thread only)."""
+        if self.destroyed:
+            return
+        queue = self._queue
+        if self._limit is not None and len(queue) >= self._limit:
+            queue.popleft()
+            self.dropped += 1
+        queue.append(msg)
+        self.received += 1
+        waiter = self._waiter
+        if waiter is not None:
+            self._waiter = None
+            if not waiter.done():
+                waiter.set_result(None)
+
+    async def _wait(self) -> None:
+        waiter = self.node._loop.create_future()
+        self._waiter = waiter
+        try:
+            await waiter
+        finally:
+            if self._waiter is waiter:
+                self._waiter = None
+
+    def _start(self) -> None:
+        """Start the dispatcher (on the node's loop)."""
+        if self.callback is not None and self._task is None:
+            self._task = self.node._create_task(
+                self._dispatch(), name=f"dispatch {self.topic_name} -> {self.node_name}"
+            )
+
+    async def _dispatch(self) -> None:
+        node = self.node
+        queue = self._queue
+        group = self.callback_group
+        callback = self.callback
+        assert callback is not None
+        handled = 0
+        while True:
+            if not queue:
+                handled = 0
+                await self._wait()
+                continue
+            msg = queue.popleft()
+            if group.exclusive:
+                self._busy += 1
+                try:
+                    await node._invoke(self, group, callback, msg)
+                finally:
+                    self._busy -= 1
+                handled += 1
+                if handled >= _BATCH:
+                    handled = 0
+                    await asyncio.sleep(0)
+            else:
+                self._busy += 1
+                task = node._create_task(node._invoke(self, group, callback, msg), name=f"callback {self.topic_name}")
+                task.add_done_callback(self._callback_done)
+
+    def _callback_done(self, _task: asyncio.Task[None]) -> None:
+        self._busy -= 1
+
+    def destroy(self) -> None:
+        if self.node is not None:
+            self.node.destroy_subscription(self)
+
+
+class MessageStream(Generic[M]):
+    """``async for msg in node.subscribe(Type, "/topic")``: a subscription read as an async iterator.
+
+    Also an async context manager; leaving it (or :meth:`close`) destroys the subscription.
+    """
+
+    def __init__(self, subscription: Subscription[M]) -> None:
+        self.subscription = subscription
+
+    def __repr__(self) -> str:
+        return f"<MessageStream of {self.subscription!r}>"
+
+    def __aiter__(self) -> MessageStream[M]:
+        return self
+
+    async def __anext__(self) -> M:
+        sub = self.subscription
+        while not sub._queue:
+            if sub.destroyed:
+                raise StopAsyncIteration
+            await sub._wait()
+        return sub._queue.popleft()
+
+    async def __aenter__(self) -> MessageStream[M]:
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if not self.subscription.destroyed:
+            self.subscription.destroy()

@@ -1,0 +1,449 @@
+"""``Runtime``: owns the bus, the clock, the loops and the pools; runs nodes; shuts down cleanly."""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import logging
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+from collections.abc import Coroutine
+from typing import Any, TypeVar
+
+from ._bus import Bus
+from ._clock import Clock
+from ._graph import EndpointInfo, Graph, NodeInfo, TopicInfo
+from ._node import Node
+from ._priority import PriorityLoop
+from ._pubsub import Publisher, Tap
+from ._qos import QoSProfile, ReliabilityPolicy
+from ._time import ClockType, Time
+from ._transport import Transport, make_transport
+from ._waker import LoopWaker, TimerFdWaker, make_waker
+
+__all__ = ["Runtime", "run"]
+
+_log = logging.getLogger("aiorobot.runtime")
+T = TypeVar("T")
+
+EXECUTORS = ("main", "priority")
+#: GIL switch interval while a priority loop runs: how long a GIL-holding thread may keep it.
+PRIORITY_SWITCH_INTERVAL_SEC = 0.0002
+#: Bounds for the shutdown sequence.
+SHUTDOWN_HOOK_TIMEOUT_SEC = 5.0
+FLUSH_TIMEOUT_SEC = 1.0
+
+
+class Runtime:
+    """Runs nodes: ``async with Runtime() as rt: rt.add_node(node); await rt.spin()``.
+
+    Parameters
+    ----------
+    transport
+        ``"local"`` (one process) or a :class:`~aiorobot._transport.Transport`.
+    domain_id
+        Separates graphs on a shared network (as ``ROS_DOMAIN_ID``).
+    use_sim_time
+        Every clock follows ``/clock`` (``rosgraph_msgs/msg/Clock``); timers fire on it.
+    strict_qos
+        Raise :class:`QoSIncompatibleError` instead of warning when endpoints do not connect.
+    config
+        A config file path (``aiorobot run`` format): its runtime settings apply and its
+        nodes are built, validated and added on entry.
+    process_workers, thread_workers
+        Sizes of the pools behind ``Node.offload`` and ``Node.run_in_thread``.
+    priority_realtime
+        Run the priority loop under ``SCHED_FIFO`` when the OS permits it.
+    handle_signals
+        While ``spin`` runs, SIGINT and SIGTERM shut the runtime down cleanly.
+    """
+
+    def __init__(
+        self,
+        *,
+        transport: str | Transport = "local",
+        domain_id: int = 0,
+        use_sim_time: bool = False,
+        strict_qos: bool = False,
+        config: Any = None,
+        process_workers: int | None = None,
+        thread_workers: int | None = None,
+        priority_realtime: bool = False,
+        handle_signals: bool = True,
+    ) -> None:
+        self._config = config
+        if config is not None:
+            from ._config import load_config
+
+            cfg = load_config(config) if isinstance(config, (str, os.PathLike)) else config
+            self._config = cfg
+            transport = cfg.runtime.transport
+            domain_id = cfg.runtime.domain_id
+            use_sim_time = cfg.runtime.use_sim_time
+            strict_qos = cfg.runtime.strict_qos
+        if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
+            raise ValueError(f"domain_id: expected an int in 0..232, found {domain_id!r}")
+        self.transport = (
+            transport if isinstance(transport, Transport) else make_transport(transport, domain_id=domain_id)
+        )
+        self.domain_id = domain_id
+        self.use_sim_time = use_sim_time
+        self.clock = Clock(ClockType.ROS_TIME, use_sim_time=use_sim_time)
+        self._bus = Bus(strict_qos=strict_qos)
+        self._bus.transport = self.transport
+        self._nodes: list[Node] = []
+        self._pending: list[tuple[Node, str]] = []
+        self._stopping: list[Any] = []
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread_id: int | None = None
+        self._waker: LoopWaker | TimerFdWaker | None = None
+        self._priority: PriorityLoop | None = None
+        self._priority_realtime = priority_realtime
+        self._process_workers = process_workers
+        self._thread_workers = thread_workers
+        self._processes: concurrent.futures.ProcessPoolExecutor | None = None
+        self._threads: concurrent.futures.ThreadPoolExecutor | None = None
+        self._shutdown_event: asyncio.Event | None = None
+        self._handle_signals = handle_signals
+        self._clock_tap: Tap | None = None
+        self._saved_switch_interval: float | None = None
+        self._state = "new"  # new -> running -> closing -> closed
+
+    def __repr__(self) -> str:
+        return (
+            f"<Runtime {self._state} transport={self.transport.name} nodes={len(self._nodes)}"
+            f"{' sim_time' if self.use_sim_time else ''}>"
+        )
+
+    @property
+    def strict_qos(self) -> bool:
+        return self._bus.strict_qos
+
+    @property
+    def nodes(self) -> tuple[Node, ...]:
+        return tuple(self._nodes)
+
+    def now(self) -> Time:
+        return self.clock.now()
+
+    # -- context --------------------------------------------------------------------
+
+    async def __aenter__(self) -> Runtime:
+        if self._state != "new":
+            raise RuntimeError(f"{self!r} cannot be entered twice")
+        built: list[tuple[Node, str]] = []
+        if self._config is not None:
+            from ._config import build_nodes
+
+            built = build_nodes(self._config)  # validate everything before anything starts
+        self._loop = asyncio.get_running_loop()
+        self._thread_id = threading.get_ident()
+        self._waker = make_waker(self._loop, precise=True)
+        self._shutdown_event = asyncio.Event()
+        await self.transport.open(self._bus)
+        if self.use_sim_time:
+            from .msgs.rosgraph_msgs import Clock as ClockMsg
+
+            self._clock_tap = Tap(
+                ClockMsg,
+                "/clock",
+                QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1),
+                self._on_clock,
+                owner="<runtime clock>",
+            )
+            self._bus.add_subscription(self._clock_tap)
+        self._state = "running"
+        try:
+            for node, executor in [*self._pending, *built]:
+                self.add_node(node, executor=executor)
+        except BaseException:
+            await self._close()
+            raise
+        self._pending.clear()
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self._close()
+
+    def _on_clock(self, msg: Any) -> None:
+        self.clock.set_sim_time(int(msg.clock.sec) * 1_000_000_000 + int(msg.clock.nanosec))
+
+    # -- nodes ------------------------------------------------------------------------
+
+    def add_node(self, node: Node, executor: str = "main") -> Node:
+        """Add ``node`` on the main loop or the priority loop and start it."""
+        if not isinstance(node, Node):
+            raise TypeError(f"add_node expects an aiorobot.Node, got {node!r}")
+        if executor not in EXECUTORS:
+            raise ValueError(f"executor: expected 'main' or 'priority', found {executor!r}")
+        if node._runtime is not None or any(n is node for n, _ in self._pending):
+            raise ValueError(f"{node!r} is already added to a runtime")
+        fqn = node.get_fully_qualified_name()
+        taken = [n.get_fully_qualified_name() for n in self._nodes] + [
+            n.get_fully_qualified_name() for n, _ in self._pending
+        ]
+        if fqn in taken:
+            raise ValueError(f"a node named {fqn} is already in this runtime; node names must be unique")
+        if self._state == "new":
+            self._pending.append((node, executor))
+            return node
+        if self._state != "running":
+            raise RuntimeError(f"cannot add {node!r}: the runtime is {self._state}")
+        if executor == "priority":
+            prio = self._priority_loop()
+            assert prio.loop is not None and prio.thread_id is not None and prio.waker is not None
+            node._bind(self, executor, prio.loop, prio.thread_id, prio.waker)
+        else:
+            assert self._loop is not None and self._thread_id is not None and self._waker is not None
+            node._bind(self, executor, self._loop, self._thread_id, self._waker)
+        added: list[Any] = []
+        try:
+            for pub in node._publishers:
+                self._bus.add_publisher(pub)
+                added.append(pub)
+            for sub in node._subscriptions:
+                self._bus.add_subscription(sub)
+                added.append(sub)
+            self._attach_extras(node)
+        except BaseException:
+            for endpoint in added:
+                self._bus.remove(endpoint)
+            node._unbind()
+            raise
+        self._nodes.append(node)
+        node._call_soon(node._start)
+        return node
+
+    def _attach_extras(self, node: Node) -> None:
+        """Register a node's other entities (services, actions) — a hook for subclasses of Node."""
+        attach = getattr(node, "_attach_entities", None)
+        if attach is not None:
+            attach()
+
+    def remove_node(self, node: Node) -> None:
+        """Stop ``node``: its endpoints leave the graph at once, its tasks end on its loop."""
+        if node not in self._nodes:
+            raise ValueError(f"{node!r} is not in this runtime")
+        self._nodes.remove(node)
+        self._detach(node)
+
+    def _detach(self, node: Node) -> None:
+        for endpoint in [*node._publishers, *node._subscriptions]:
+            self._bus.remove(endpoint)
+        detach = getattr(node, "_detach_entities", None)
+        if detach is not None:
+            detach()
+        loop = node._loop
+        if loop is not None and not loop.is_closed():
+            if loop is self._loop:
+                self._stopping.append(asyncio.ensure_future(node._stop(), loop=loop))
+            else:
+                self._stopping.append(asyncio.run_coroutine_threadsafe(node._stop(), loop))
+        node._unbind()
+
+    def _priority_loop(self) -> PriorityLoop:
+        if self._priority is None:
+            prio = PriorityLoop(realtime=self._priority_realtime)
+            prio.start()
+            self._priority = prio
+            self._saved_switch_interval = sys.getswitchinterval()
+            sys.setswitchinterval(min(self._saved_switch_interval, PRIORITY_SWITCH_INTERVAL_SEC))
+        return self._priority
+
+    @property
+    def priority_loop(self) -> PriorityLoop | None:
+        return self._priority
+
+    # -- running ------------------------------------------------------------------------
+
+    async def spin(self, duration_sec: float | None = None) -> None:
+        """Run until :meth:`shutdown` (or SIGINT/SIGTERM), or for ``duration_sec`` of wall time."""
+        if self._state != "running" or self._shutdown_event is None:
+            raise RuntimeError(f"spin needs an entered runtime: use `async with Runtime() as rt` ({self!r})")
+        if duration_sec is not None and (isinstance(duration_sec, bool) or not duration_sec >= 0):
+            raise ValueError(f"spin duration_sec: expected a number >= 0 or None, got {duration_sec!r}")
+        installed = self._install_signal_handlers()
+        try:
+            if duration_sec is None:
+                await self._shutdown_event.wait()
+            else:
+                try:
+                    await asyncio.wait_for(self._shutdown_event.wait(), duration_sec)
+                except TimeoutError:
+                    pass
+        finally:
+            for sig in installed:
+                assert self._loop is not None
+                self._loop.remove_signal_handler(sig)
+
+    def _install_signal_handlers(self) -> list[int]:
+        if not self._handle_signals or threading.current_thread() is not threading.main_thread():
+            return []
+        installed = []
+        assert self._loop is not None
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            try:
+                self._loop.add_signal_handler(sig, self._on_signal, sig)
+                installed.append(sig)
+            except (NotImplementedError, RuntimeError, ValueError):
+                pass
+        return installed
+
+    def _on_signal(self, sig: int) -> None:
+        _log.info(f"{signal.Signals(sig).name} received: shutting down")
+        self.shutdown()
+
+    def shutdown(self) -> None:
+        """Ask ``spin`` to return (from any thread). ``async with`` then stops everything."""
+        event, loop = self._shutdown_event, self._loop
+        if event is None or loop is None:
+            return
+        if threading.get_ident() == self._thread_id:
+            event.set()
+        elif not loop.is_closed():
+            loop.call_soon_threadsafe(event.set)
+
+    @property
+    def is_shutdown(self) -> bool:
+        return self._state in ("closing", "closed") or (
+            self._shutdown_event is not None and self._shutdown_event.is_set()
+        )
+
+    # -- shutdown -----------------------------------------------------------------------
+
+    async def _on_loop(self, node: Node, coro: Coroutine[Any, Any, T]) -> T:
+        if node._loop is self._loop or node._loop is None:
+            return await coro
+        assert self._priority is not None
+        return await self._priority.run(coro)
+
+    async def _close(self) -> None:
+        if self._state in ("closing", "closed"):
+            return
+        self._state = "closing"
+        nodes = list(self._nodes)
+        # 1. on_shutdown hooks, each on its node's loop (controllers send their last command here).
+        if nodes:
+            hooks = [
+                self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown")) for n in nodes if n._started
+            ]
+            done, pending = await asyncio.wait(
+                [asyncio.ensure_future(h) for h in hooks] or [asyncio.ensure_future(asyncio.sleep(0))],
+                timeout=SHUTDOWN_HOOK_TIMEOUT_SEC,
+            )
+            for task in pending:
+                task.cancel()
+                _log.warning("an on_shutdown hook did not finish in time and was cancelled")
+            if pending:
+                await asyncio.gather(*pending, return_exceptions=True)
+            # 2. Let what the hooks published reach its subscribers.
+            await self._flush(nodes)
+        # 3. Stop every node.
+        for node in nodes:
+            self._nodes.remove(node)
+            self._detach(node)
+        if self._stopping:
+            await asyncio.gather(
+                *[f if isinstance(f, asyncio.Future) else asyncio.wrap_future(f) for f in self._stopping],
+                return_exceptions=True,
+            )
+            self._stopping.clear()
+        if self._clock_tap is not None:
+            self._bus.remove(self._clock_tap)
+            self._clock_tap = None
+        # 4. Loops, transport, pools.
+        if self._priority is not None:
+            self._priority.stop()
+            self._priority = None
+            if self._saved_switch_interval is not None:
+                sys.setswitchinterval(self._saved_switch_interval)
+        await self.transport.close()
+        if self._processes is not None:
+            self._processes.shutdown(wait=True, cancel_futures=True)
+            self._processes = None
+        if self._threads is not None:
+            self._threads.shutdown(wait=True, cancel_futures=True)
+            self._threads = None
+        if self._waker is not None:
+            self._waker.close()
+            self._waker = None
+        self._state = "closed"
+
+    async def _flush(self, nodes: list[Node]) -> None:
+        """Wait (bounded) until every subscription has handled what is queued for it."""
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + FLUSH_TIMEOUT_SEC
+        quiet_rounds = 0
+        while loop.time() < deadline:
+            await asyncio.sleep(0)
+            if self._priority is not None and self._priority.loop is not None:
+                # A round trip through the priority loop drains its call_soon_threadsafe queue.
+                await self._priority.run(asyncio.sleep(0))
+            if all(n._idle() for n in nodes):
+                quiet_rounds += 1
+                if quiet_rounds >= 2:
+                    return
+            else:
+                quiet_rounds = 0
+                await asyncio.sleep(0.001)
+
+    # -- pools ----------------------------------------------------------------------------
+
+    def _process_pool(self) -> concurrent.futures.ProcessPoolExecutor:
+        if self._state != "running":
+            raise RuntimeError(f"offload needs a running runtime ({self!r})")
+        if self._processes is None:
+            method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+            self._processes = concurrent.futures.ProcessPoolExecutor(
+                max_workers=self._process_workers or os.cpu_count() or 2,
+                mp_context=multiprocessing.get_context(method),
+            )
+        return self._processes
+
+    def _thread_pool(self) -> concurrent.futures.ThreadPoolExecutor:
+        if self._state != "running":
+            raise RuntimeError(f"run_in_thread needs a running runtime ({self!r})")
+        if self._threads is None:
+            self._threads = concurrent.futures.ThreadPoolExecutor(
+                max_workers=self._thread_workers or min(32, (os.cpu_count() or 2) + 4),
+                thread_name_prefix="aiorobot-worker",
+            )
+        return self._threads
+
+    # -- introspection ------------------------------------------------------------------
+
+    @property
+    def graph(self) -> Graph:
+        """A snapshot of nodes, topics (types and QoS of every endpoint) and QoS incompatibilities."""
+        nodes = tuple(
+            NodeInfo(n.get_name(), n.get_namespace(), n.get_fully_qualified_name(), n.executor or "")
+            for n in self._nodes
+        )
+        topics = []
+        for t in self._bus.snapshot():
+            def info(e: Any, kind: str, topic: str = t.name) -> EndpointInfo:
+                return EndpointInfo(e.node_name, topic, e.type_name, kind, e.qos)
+
+            pubs = tuple(info(p, "publisher") for p in t.publishers)
+            subs = tuple(info(s, "subscription") for s in t.subscriptions)
+            types = tuple(sorted({e.type for e in (*pubs, *subs)}))
+            topics.append(TopicInfo(t.name, types, pubs, subs))
+        extra = getattr(self, "_graph_extras", None)
+        services, actions = extra() if extra is not None else ((), ())
+        return Graph(nodes, tuple(topics), tuple(self._bus.incompatibilities()), services, actions)
+
+
+def run(main: Coroutine[Any, Any, T], *, debug: bool | None = None) -> T:
+    """Run ``main`` to completion on a uvloop event loop (``asyncio.run`` elsewhere)."""
+    try:
+        import uvloop
+    except ImportError:  # pragma: no cover
+        return asyncio.run(main, debug=debug)
+    with asyncio.Runner(loop_factory=uvloop.new_event_loop, debug=debug) as runner:
+        return runner.run(main)
+
+
+
