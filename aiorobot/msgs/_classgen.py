@@ -1,0 +1,271 @@
+"""Message, service and action classes, generated per type from its spec.
+
+Each message class is built from generated source (``exec``), so construction,
+comparison and ``repr`` run straight-line code: a ``Twist()`` costs about a
+microsecond. Numeric arrays are numpy arrays; mutable defaults are made fresh
+for every instance.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ._spec import ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
+
+__all__ = ["Action", "Message", "Service", "build_class"]
+
+_ndarray = np.ndarray
+
+
+class Message:
+    """Base class of every generated message class."""
+
+    __slots__ = ()
+    __msgtype__: ClassVar[str] = ""
+    _field_types: ClassVar[dict[str, str]] = {}
+
+    @classmethod
+    def get_fields_and_field_types(cls) -> dict[str, str]:
+        """Field names and their .msg types, in definition order (as rclpy)."""
+        return dict(cls._field_types)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        from ._registry import rebuild
+
+        return rebuild, (self.__msgtype__, tuple(getattr(self, n) for n in self.__slots__))
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, compared by value
+
+
+class _InterfaceMeta(type):
+    def __repr__(cls) -> str:
+        return f"<{cls.__mro__[1].__name__.lower()} type {cls.__msgtype__}>"  # type: ignore[attr-defined]
+
+
+class Service(metaclass=_InterfaceMeta):
+    """Base class of service types: ``Request``, ``Response`` and ``Event`` message classes."""
+
+    __msgtype__: ClassVar[str] = ""
+    Request: ClassVar[type[Message]]
+    Response: ClassVar[type[Message]]
+    Event: ClassVar[type[Message]]
+
+    def __init__(self) -> None:
+        name = type(self).__name__
+        raise TypeError(f"{type(self).__msgtype__} is a service type, not a message: construct "
+                        f"{name}.Request() or {name}.Response() instead")
+
+
+class Action(metaclass=_InterfaceMeta):
+    """Base class of action types.
+
+    ``Goal``, ``Result``, ``Feedback`` and what a transport needs: the ``SendGoal`` and
+    ``GetResult`` services and ``FeedbackMessage``, structured as in ROS 2.
+    """
+
+    __msgtype__: ClassVar[str] = ""
+    Goal: ClassVar[type[Message]]
+    Result: ClassVar[type[Message]]
+    Feedback: ClassVar[type[Message]]
+    SendGoal: ClassVar[type[Service]]
+    GetResult: ClassVar[type[Service]]
+    FeedbackMessage: ClassVar[type[Message]]
+
+    def __init__(self) -> None:
+        name = type(self).__name__
+        raise TypeError(f"{type(self).__msgtype__} is an action type, not a message: construct "
+                        f"{name}.Goal(), {name}.Result() or {name}.Feedback() instead")
+
+
+_DTYPES: dict[str, np.dtype[Any]] = {k: np.dtype(v[2]) for k, v in PRIMITIVES.items()}
+_EMPTY: dict[str, np.ndarray] = {}
+
+
+def dtype_of(base: str) -> np.dtype[Any]:
+    return _DTYPES[base]
+
+
+def as_array(value: Any, dtype: np.dtype[Any]) -> np.ndarray:
+    """``value`` as a 1-D C-contiguous array of ``dtype`` (no copy when it already is one)."""
+    if value.__class__ is _ndarray and value.dtype == dtype and value.ndim == 1 and (
+            value.flags.c_contiguous):
+        return value
+    if isinstance(value, (bytes, bytearray, memoryview)) and dtype.itemsize == 1:
+        return np.frombuffer(value, dtype).copy()
+    return np.ascontiguousarray(value, dtype).reshape(-1)
+
+
+def as_fixed_array(value: Any, dtype: np.dtype[Any], count: int, where: str) -> np.ndarray:
+    arr = as_array(value, dtype)
+    if arr.shape[0] != count:
+        raise ValueError(f"{where} is a fixed array of {count} elements, got {arr.shape[0]}")
+    return arr
+
+
+def _zero_literal(base: str) -> str:
+    if base == "bool":
+        return "False"
+    if base in ("float32", "float64"):
+        return "0.0"
+    if base in ("string", "wstring"):
+        return "''"
+    return "0"
+
+
+def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type]) -> str:
+    names = [f.name for f in spec.fields]
+    params: list[str] = []
+    body: list[str] = []
+    eq: list[str] = []
+    for i, f in enumerate(spec.fields):
+        t: FieldType = f.type
+        n = f.name
+        where = f"{spec.name}.{n}"
+        if t.kind == SCALAR and not t.is_message:
+            default = repr(f.default) if f.default is not None else _zero_literal(t.base)
+            params.append(f"{n}={default}")
+            body.append(f"self.{n} = {n}")
+            eq.append(f"self.{n} == other.{n}")
+            continue
+        params.append(f"{n}=None")
+        if t.kind == SCALAR:  # nested message
+            ns[f"_T{i}"] = get(t.base)
+            body.append(f"self.{n} = _T{i}() if {n} is None else {n}")
+            eq.append(f"self.{n} == other.{n}")
+        elif t.is_primitive:
+            ns[f"_D{i}"] = _DTYPES[t.base]
+            if f.default is not None:
+                ns[f"_V{i}"] = np.array(f.default, _DTYPES[t.base])
+                fresh = f"_V{i}.copy()"
+            elif t.kind == ARRAY:
+                fresh = f"_zeros({t.count}, _D{i})"
+            else:
+                fresh = f"_empty(0, _D{i})"
+            if t.kind == ARRAY:
+                conv = f"_farr({n}, _D{i}, {t.count}, {where!r})"
+            else:
+                conv = f"_arr({n}, _D{i})"
+            body.append(f"self.{n} = {fresh} if {n} is None else {conv}")
+            eq.append(f"_aeq(self.{n}, other.{n})")
+        elif t.is_string:
+            if f.default is not None:
+                fresh = repr(list(f.default))
+            elif t.kind == ARRAY:
+                fresh = f"[''] * {t.count}"
+            else:
+                fresh = "[]"
+            body.append(f"self.{n} = {fresh} if {n} is None else {n}")
+            eq.append(f"self.{n} == other.{n}")
+        else:  # arrays and sequences of messages
+            ns[f"_T{i}"] = get(t.base)
+            fresh = f"[_T{i}() for _ in range({t.count})]" if t.kind == ARRAY else "[]"
+            body.append(f"self.{n} = {fresh} if {n} is None else {n}")
+            eq.append(f"self.{n} == other.{n}")
+    dotted = spec.name.replace("/", ".")
+    reprs = ", ".join(f"{n}={{self.{n}!r}}" for n in names)
+    lines = [
+        f"class {spec.short_name}(_Message):",
+        f"    __slots__ = {tuple(names)!r}",
+        f"    __msgtype__ = {spec.name!r}",
+    ]
+    lines += [f"    {c.name} = {c.value!r}" for c in spec.constants]
+    lines += [
+        f"    def __init__(self, {', '.join(params)}):",
+        *(f"        {b}" for b in body),
+        "    def __eq__(self, other):",
+        "        if other.__class__ is not self.__class__:",
+        "            return NotImplemented",
+        f"        return bool({' and '.join(eq)})",
+        "    def __repr__(self):",
+        f"        return f'{dotted}({reprs})'",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> type:
+    ns: dict[str, Any] = {
+        "_Message": Message, "_zeros": np.zeros, "_empty": np.empty, "_arr": as_array,
+        "_farr": as_fixed_array, "_aeq": np.array_equal,
+    }
+    source = _class_source(spec, ns, get)
+    code = compile(source, f"<aiorobot.msgs {spec.name}>", "exec")
+    exec(code, ns)  # noqa: S102 - source generated from a validated spec
+    cls: type = ns[spec.short_name]
+    cls.__module__ = f"aiorobot.msgs.{spec.package}"
+    cls.__qualname__ = qualname
+    cls.__doc__ = f"ROS 2 message {spec.name}."
+    cls._field_types = {f.name: str(f.type) for f in spec.fields}  # type: ignore[attr-defined]
+    cls._spec = spec  # type: ignore[attr-defined]
+    return cls
+
+
+def _namespace(cls_name: str, base: type, msgtype: str, package: str, qualname: str,
+               members: dict[str, Any]) -> type:
+    cls = _InterfaceMeta(cls_name, (base,), {"__msgtype__": msgtype, "__slots__": (), **members})
+    cls.__module__ = f"aiorobot.msgs.{package}"
+    cls.__qualname__ = qualname
+    return cls
+
+
+def build_class(spec: Any, get: Callable[[str], type]) -> type:
+    """Build the class for a MsgSpec, ServiceSpec or ActionSpec (parts via ``get``)."""
+    from ._registry import ActionSpec, ServiceSpec
+
+    pkg, kind, short = spec.name.split("/")
+    if isinstance(spec, MsgSpec):
+        if kind == "msg":
+            return _message_class(spec, get, short)
+        from ._registry import _owner
+
+        owner = get(_owner(spec.name))  # building the owner builds and caches this part
+        for cls in _walk(owner):
+            if getattr(cls, "__msgtype__", None) == spec.name:
+                return cls
+        raise LookupError(f"{spec.name} is not part of {owner.__msgtype__}")  # pragma: no cover
+    if isinstance(spec, ServiceSpec):
+        owner_short = spec.name.rsplit("/", 1)[1]
+        qual = owner_short if kind == "srv" else ".".join(owner_short.rsplit("_", 1))
+        parts = {
+            "Request": _message_class(spec.request, get, f"{qual}.Request"),
+            "Response": _message_class(spec.response, get, f"{qual}.Response"),
+        }
+        parts["Event"] = _message_class(spec.event, _with(get, parts), f"{qual}.Event")
+        return _namespace(qual.rsplit(".", 1)[-1], Service, spec.name, pkg, qual, parts)
+    assert isinstance(spec, ActionSpec)
+    members: dict[str, Any] = {
+        "Goal": _message_class(spec.goal, get, f"{short}.Goal"),
+        "Result": _message_class(spec.result, get, f"{short}.Result"),
+        "Feedback": _message_class(spec.feedback, get, f"{short}.Feedback"),
+    }
+    local = _with(get, members)
+    members["SendGoal"] = build_class(spec.send_goal, local)
+    members["GetResult"] = build_class(spec.get_result, local)
+    members["FeedbackMessage"] = _message_class(spec.feedback_message, local,
+                                                f"{short}.FeedbackMessage")
+    return _namespace(short, Action, spec.name, pkg, short, members)
+
+
+def _with(get: Callable[[str], type], parts: dict[str, Any]) -> Callable[[str], type]:
+    """A ``get`` that also knows classes being built (not yet in the registry)."""
+    by_name = {}
+    for cls in parts.values():
+        for c in _walk(cls):
+            by_name[c.__msgtype__] = c
+
+    def local_get(name: str) -> type:
+        return by_name.get(name) or get(name)
+
+    return local_get
+
+
+def _walk(cls: type) -> list[type]:
+    out = [cls]
+    for attr in ("Request", "Response", "Event", "Goal", "Result", "Feedback", "SendGoal",
+                 "GetResult", "FeedbackMessage"):
+        sub = cls.__dict__.get(attr)
+        if sub is not None:
+            out += _walk(sub)
+    return out
