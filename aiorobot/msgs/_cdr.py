@@ -71,7 +71,8 @@ class _Gen:
         self.fmt = ""
         self.items: list[str] = []
         self.item_ctx: list[tuple[str, str]] = []
-        self.dynamic = False  # anything but one struct call was emitted
+        self.dynamic = False  # anything but struct calls was emitted
+        self.packs = 0
 
     # -- helpers ---------------------------------------------------------------
     def name(self, prefix: str) -> str:
@@ -99,7 +100,8 @@ class _Gen:
         self.flush()
         self.dynamic = True
         if self.kind == "ser":
-            self.emit(f"b += _PAD[(4 - len(b)) & {size - 1}]", ctx)
+            self.emit(f"_ap(_PAD[-p & {size - 1}])", ctx)
+            self.emit(f"p = (p + {size - 1}) & -{size}")
         else:
             self.emit(f"p += (4 - p) & {size - 1}", ctx)
         self.mod, self.rem = size, 0
@@ -128,13 +130,16 @@ class _Gen:
         if not items:  # only padding
             self.dynamic = True
             if self.kind == "ser":
-                self.emit(f"b += _PAD[{st.size}]")
+                self.emit(f"_ap(_PAD[{st.size}])")
+                self.emit(f"p += {st.size}")
             else:
                 self.emit(f"p += {st.size}")
             return
         s = self.const("_S", st)
         if self.kind == "ser":
-            self.emit(f"b += {s}.pack({', '.join(items)})", ctx)
+            self.packs += 1
+            self.emit(f"_ap({s}.pack({', '.join(items)}))", ctx)
+            self.emit(f"p += {st.size}")
         else:
             self.emit(f"{', '.join(items)}, = {s}.unpack_from(d, p)", ctx)
             self.emit(f"p += {st.size}")
@@ -174,7 +179,8 @@ def _ser_value(g: _Gen, t: FieldType, expr: str, path: str) -> None:
             g.align(size, ctx)
             g.flush()
             g.dynamic = True
-            g.emit(f"b += {arr}.tobytes()", ctx)
+            g.emit(f"_ap({arr}.tobytes())", ctx)
+            g.emit(f"p += {size * t.count}")
             g.advance(size * t.count)
             return
         g.emit(f"{arr} = _arr({expr}, {dt})", ctx)
@@ -183,8 +189,11 @@ def _ser_value(g: _Gen, t: FieldType, expr: str, path: str) -> None:
         g.flush()
         g.dynamic = True
         if size > 4:
-            g.emit(f"if len({arr}): b += _PAD[(4 - len(b)) & {size - 1}]", ctx)
-        g.emit(f"b += {arr}.data", ctx)
+            g.emit(f"if p & 7 and len({arr}):", ctx)
+            g.emit("    _ap(_PAD[4])")
+            g.emit("    p += 4")
+        g.emit(f"_ap({arr}.data)", ctx)
+        g.emit(f"p += {arr}.nbytes")
         g.unknown(min(size, 4))
         return
     seq = g.name("_l")
@@ -230,29 +239,40 @@ def _ser_string(g: _Gen, t: FieldType, expr: str, path: str) -> None:
     g.primitive("uint32", length, path)
     g.flush()
     g.dynamic = True
-    g.emit(f"b += {enc}", ctx)
+    g.emit(f"_ap({enc})", ctx)
     if t.base == "string":
-        g.emit("b.append(0)")
+        g.emit("_ap(_NUL)")
+        g.emit(f"p += len({enc}) + 1")
         g.unknown()
     else:
+        g.emit(f"p += len({enc})")
         g.unknown(2)
 
 
 def _build_serializer(cls: type) -> Callable[[Any], bytes]:
     spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
     g = _Gen("<", "ser")
-    g.emit("b = bytearray(_HDR)")
+    g.emit("o = [_HDR]")
+    g.emit("_ap = o.append")
+    g.emit("p = 0")
     _ser_fields(g, spec, "m", "")
     g.flush()
     g.ns["_HDR"] = _HEADER_LE
-    if not g.dynamic and sum(" += " in line for line in g.lines) == 1:
-        # one struct call: no bytearray needed
-        g.lines = [line.replace("b += ", "return _HDR + ") for line in g.lines[1:]]
-        ctx = {k - 1: v for k, v in g.ctx.items()}
-        g.ctx = ctx
+    g.ns["_NUL"] = b"\x00"
+    if not g.dynamic and g.packs == 1:
+        # a fixed layout: one struct call, no list needed
+        keep: list[str] = []
+        ctx: dict[int, list[tuple[str, str]]] = {}
+        for lineno, line in enumerate(g.lines[3:], 5):  # line 2 is the first emitted one
+            if line.strip().startswith("p +="):
+                continue
+            keep.append(line.replace("_ap(", "return _HDR + (", 1))
+            if lineno in g.ctx:
+                ctx[len(keep) + 1] = g.ctx[lineno]
+        g.lines, g.ctx = keep, ctx
         src = g.source("def serialize(m):", [])
     else:
-        src = g.source("def serialize(m):", ["return bytes(b)"])
+        src = g.source("def serialize(m):", ["return b''.join(o)"])
     return _compile(src, g, f"<aiorobot.msgs CDR serializer {spec.name}>", "serialize")
 
 
@@ -380,21 +400,22 @@ def _compile(src: str, g: _Gen, filename: str, fname: str) -> Any:
     code = compile(src, filename, "exec")
     exec(code, g.ns)  # noqa: S102 - generated from a validated spec
     fn = g.ns[fname]
-    _CONTEXT[fn.__code__] = g.ctx
-    _SOURCES[fn.__code__] = src
+    # keyed by id: equal code objects (e.g. Twist's and Wrench's codecs) compare equal
+    _CONTEXT[id(fn.__code__)] = (fn.__code__, g.ctx)
+    _SOURCES[id(fn.__code__)] = src
     return fn
 
 
-_CONTEXT: dict[CodeType, dict[int, list[tuple[str, str]]]] = {}
-_SOURCES: dict[CodeType, str] = {}
+_CONTEXT: dict[int, tuple[CodeType, dict[int, list[tuple[str, str]]]]] = {}
+_SOURCES: dict[int, str] = {}
 
 
 def _where(tb: TracebackType | None) -> tuple[list[tuple[str, str]], dict[str, Any]]:
     """The (path, type) entries and locals of the generated line that failed."""
     while tb is not None:
-        table = _CONTEXT.get(tb.tb_frame.f_code)
-        if table is not None:
-            return table.get(tb.tb_lineno, []), dict(tb.tb_frame.f_locals)
+        entry = _CONTEXT.get(id(tb.tb_frame.f_code))
+        if entry is not None and entry[0] is tb.tb_frame.f_code:
+            return entry[1].get(tb.tb_lineno, []), dict(tb.tb_frame.f_locals)
         tb = tb.tb_next
     return [], {}
 
@@ -499,7 +520,7 @@ def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str) -> A
                         "use .Request or .Response, for actions .Goal, .Result, .Feedback")
     n = len(data)
     if n < 4:
-        raise DeserializationError(f"cannot deserialize {cls.__msgtype__}: {n} bytes is too short "
+        raise DeserializationError(f"cannot deserialize {cls.__msgtype__}: got {n} bytes, too short "
                                    "for the 4-byte CDR encapsulation header")
     if data[0] != 0 or data[1] not in (0, 1):
         raise DeserializationError(
@@ -544,4 +565,4 @@ def _debug_source(msg_type: type | str, kind: str = "ser") -> str:  # pragma: no
     """The generated source of a codec (for debugging the generator)."""
     cls = msg_type if isinstance(msg_type, type) else get(msg_type)
     fn = _build_serializer(cls) if kind == "ser" else _build_deserializer(cls, "<")
-    return _SOURCES[fn.__code__]
+    return _SOURCES[id(fn.__code__)]
