@@ -34,6 +34,7 @@ from ._math import (
     rotate_vectors,
     transform_from_pq,
 )
+from ._urdf import URDFError, UrdfJoint, UrdfModel, load_urdf, parse_urdf
 
 __all__ = [
     "Buffer",
@@ -43,13 +44,18 @@ __all__ = [
     "InvalidArgumentException",
     "LookupException",
     "TransformException",
+    "URDFError",
+    "UrdfJoint",
+    "UrdfModel",
     "apply_transform",
     "canonical_quaternion",
     "concat",
     "do_transform",
     "euler_from_quaternion",
     "invert_transform",
+    "load_urdf",
     "matrix_from_quaternion",
+    "parse_urdf",
     "pq_from_transform",
     "quaternion_from_euler",
     "quaternion_from_matrix",
