@@ -3,9 +3,19 @@
 Pure cores (numpy in, numpy out, no runtime): :class:`DiffDrive`, :class:`Mecanum`,
 :func:`saturate_wheel_speeds`, :func:`integrate_twist`, :class:`WheelOdometry`,
 :class:`PID`, :class:`VelocitySmoother`, :class:`GoToGoal`, :class:`PurePursuit`.
+
+Serial motor protocol (``docs/serial-protocol.md``): framing (:func:`encode_message`,
+:class:`StreamDecoder`), messages, :class:`SerialLink`, and a simulated firmware
+(:class:`SimulatedFirmware`, :class:`PtyFirmware`).
+
+Nodes: :class:`DiffDriveController`, :class:`MecanumController`,
+:class:`SerialMotorBridge`, :class:`SimulatedFirmwareNode`.
 """
 
 from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 from ._decoder import DecoderStatistics, StreamDecoder
 from ._framing import (
@@ -49,7 +59,33 @@ from ._serial_link import LinkState, LinkStatistics, SerialLink
 from ._sim_firmware import PtyFirmware, SimulatedFirmware
 from ._smoother import VelocitySmoother
 
+# Nodes import the runtime; they load on first use so the pure cores stay importable alone.
+_NODES = {
+    "BaseController": "._base_controller",
+    "DiffDriveController": "._base_controller",
+    "MecanumController": "._base_controller",
+    "odometry_message": "._base_controller",
+    "SerialMotorBridge": "._serial_bridge",
+    "SimulatedFirmwareNode": "._sim_firmware_node",
+}
+
+if TYPE_CHECKING:
+    from ._base_controller import BaseController, DiffDriveController, MecanumController, odometry_message
+    from ._serial_bridge import SerialMotorBridge
+    from ._sim_firmware_node import SimulatedFirmwareNode
+
+
+def __getattr__(name: str) -> Any:
+    module = _NODES.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
 __all__ = [
+    "BaseController",
     "check_path",
     "ClearEmergencyStop",
     "cobs_decode",
@@ -59,6 +95,7 @@ __all__ = [
     "decode_message",
     "DecoderStatistics",
     "DiffDrive",
+    "DiffDriveController",
     "DriveCommand",
     "EmergencyStop",
     "encode_message",
@@ -73,14 +110,16 @@ __all__ = [
     "HostHeartbeat",
     "integrate_twist",
     "Kinematics",
+    "LinkState",
+    "LinkStatistics",
     "MAX_ENCODED_FRAME_BYTES",
     "MAX_PAYLOAD_BYTES",
     "MAX_WHEELS",
-    "LinkState",
-    "LinkStatistics",
     "Mecanum",
+    "MecanumController",
     "Message",
     "MsgId",
+    "odometry_message",
     "Packet",
     "parse_packet",
     "PID",
@@ -90,8 +129,10 @@ __all__ = [
     "ResetEncoders",
     "saturate_wheel_speeds",
     "SerialLink",
+    "SerialMotorBridge",
     "SetWheelVelocities",
     "SimulatedFirmware",
+    "SimulatedFirmwareNode",
     "StreamDecoder",
     "tick_delta",
     "VelocitySmoother",
