@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
-import json
 from typing import Any
 
 from ._registry import ActionSpec, ServiceSpec, get_spec
@@ -90,6 +88,9 @@ def type_hash(msg_type: type | str) -> str:
         for _, t in fields:
             if t.is_message:
                 visit(get_spec(t.base))
+
+    import hashlib
+    import json
 
     visit(top)
     doc = {

@@ -21,6 +21,7 @@ __all__ = [
     "ActionSpec",
     "ServiceSpec",
     "all_names",
+    "exists",
     "get",
     "get_spec",
     "package_names",
@@ -180,10 +181,15 @@ def normalize_name(name: str) -> str:
         pkg, short = parts
         for kind in ("msg", "srv", "action"):
             full = f"{pkg}/{kind}/{short}"
-            if full in _specs or full in _jazzy() or _owner(full) in _shipped():
+            if exists(full):
                 return full
         return f"{pkg}/msg/{short}"
     return "/".join(parts)
+
+
+def exists(name: str) -> bool:
+    """Whether the full interface name ``pkg/kind/Name`` is known (no loading, no errors)."""
+    return name in _specs or name in _jazzy() or _owner(name) in _shipped()
 
 
 def all_names() -> list[str]:
