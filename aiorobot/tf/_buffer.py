@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._buffer_core import DEFAULT_CACHE_TIME_SEC, BufferCore
+from ._buffer_core import DEFAULT_CACHE_TIME_SEC, BufferCore, check_frame_id_syntax
 from ._cache import display_time
 from ._conversions import check_supported
 from ._exceptions import ExtrapolationException, TransformException
@@ -143,6 +143,12 @@ class Buffer(BufferCore):
 
     def _register(self, w: _Waiter) -> bool:
         """Add a waiter unless already satisfied; True when it must wait. Raises a final failure."""
+        if w.target != w.source or w.full is not None:
+            # ids that can never become valid fail at once instead of at the timeout
+            check_frame_id_syntax(w.target, "wait_for_transform argument target_frame")
+            check_frame_id_syntax(w.source, "wait_for_transform argument source_frame")
+            if w.full is not None:
+                check_frame_id_syntax(w.full[2], "wait_for_transform argument fixed_frame")
         with self._waiters_lock:
             done, failure = self._state(w)
             if done:

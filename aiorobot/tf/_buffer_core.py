@@ -194,20 +194,7 @@ class BufferCore:
 
     def _validate(self, frame_id: Any, where: str) -> int:
         """Frame number of ``frame_id``, or raise as tf2's ``validateFrameId`` (lock held)."""
-        if not isinstance(frame_id, str):
-            raise InvalidArgumentException(
-                f"Invalid argument {frame_id!r} passed to {where} - expected a frame id string, "
-                f"got {type(frame_id).__name__}"
-            )
-        if not frame_id:
-            raise InvalidArgumentException(
-                f'Invalid argument "{frame_id}" passed to {where} - in tf2 frame_ids cannot be empty'
-            )
-        if frame_id.startswith("/"):
-            raise InvalidArgumentException(
-                f'Invalid argument "{frame_id}" passed to {where} - in tf2 frame_ids cannot start '
-                f"with a '/'; use \"{frame_id.lstrip('/')}\""
-            )
+        check_frame_id_syntax(frame_id, where)
         fid = self._ids.get(frame_id, 0)
         if fid == 0:
             known = ", ".join(self._names[1:21]) + (", ..." if len(self._names) > 21 else "")
@@ -645,6 +632,24 @@ class BufferCore:
             )
         lines.append("}")
         return "\n".join(lines) + "\n"
+
+
+def check_frame_id_syntax(frame_id: Any, where: str) -> None:
+    """Raise InvalidArgumentException for a non-string, empty or '/'-prefixed frame id."""
+    if not isinstance(frame_id, str):
+        raise InvalidArgumentException(
+            f"Invalid argument {frame_id!r} passed to {where} - expected a frame id string, "
+            f"got {type(frame_id).__name__}"
+        )
+    if not frame_id:
+        raise InvalidArgumentException(
+            f'Invalid argument "{frame_id}" passed to {where} - in tf2 frame_ids cannot be empty'
+        )
+    if frame_id.startswith("/"):
+        raise InvalidArgumentException(
+            f'Invalid argument "{frame_id}" passed to {where} - in tf2 frame_ids cannot start '
+            f"with a '/'; use \"{frame_id.lstrip('/')}\""
+        )
 
 
 def _dot_escape(text: str) -> str:

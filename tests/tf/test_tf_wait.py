@@ -9,7 +9,7 @@ import pytest
 from _tf_helpers import sec_of, tf, xyz_of
 
 from aiorobot import Time
-from aiorobot.tf import Buffer, ExtrapolationException, LookupException
+from aiorobot.tf import Buffer, ExtrapolationException, InvalidArgumentException, LookupException
 
 GENEROUS_SEC = 30.0  # bounds only a broken wake-up would reach
 
@@ -86,6 +86,14 @@ async def test_timeout_raises_the_error_that_still_holds():
     b.set_transform(tf("map", "base_link", 2), "t")
     with pytest.raises(ExtrapolationException, match=r"^Timed out after 0.01 s .*extrapolation into the future"):
         await b.lookup_transform_async("map", "base_link", Time(seconds=5), timeout_sec=0.01)
+
+
+async def test_malformed_frame_ids_fail_at_once_instead_of_waiting():
+    b = Buffer()
+    with pytest.raises(InvalidArgumentException, match=r"frame_ids cannot start with a '/'"):
+        await b.wait_for_transform("/map", "base_link", Time(), timeout_sec=GENEROUS_SEC)
+    with pytest.raises(InvalidArgumentException, match=r"frame_ids cannot be empty"):
+        await b.lookup_transform_async("map", "", Time(), timeout_sec=GENEROUS_SEC)
 
 
 async def test_a_time_older_than_the_cache_can_hold_fails_at_once():
