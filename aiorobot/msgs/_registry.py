@@ -192,11 +192,15 @@ def exists(name: str) -> bool:
     return name in _specs or name in _jazzy() or _owner(name) in _shipped()
 
 
-def all_names() -> list[str]:
-    """Every known interface name (messages, services, actions; not their parts)."""
+def all_names(*, registered: bool = True) -> list[str]:
+    """Every known interface name (messages, services, actions; not their parts).
+
+    ``registered=False`` leaves out user registrations (only the built-in definitions).
+    """
     with _lock:
         names = set(_jazzy()) | set(_shipped())
-        names |= {n for n in _specs if _owner(n) == n}
+        if registered:
+            names |= {n for n in _specs if _owner(n) == n}
     return sorted(names)
 
 
@@ -215,7 +219,7 @@ def get_spec(name: str) -> Spec:
         if spec is None:
             spec = _load_builtin(full)
     if spec is None:
-        close = difflib.get_close_matches(full, all_names(), n=3, cutoff=0.6)
+        close = difflib.get_close_matches(full, all_names(), n=3, cutoff=0.8)
         hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else (
             "; register it with aiorobot.msgs.register_msg/register_srv/register_action/"
             "register_file")
@@ -271,7 +275,13 @@ def _register(text: str, name: str, kind: str) -> type:
                 f"{_describe(existing)}\nnew definition:\n{_describe(spec)}\n"
                 "Use a different type name for the new definition.")
         _install(spec)
-    return get(name)
+        try:
+            return get(name)
+        except LookupError as exc:  # a nested type is unknown: register nothing
+            for part in _parts(spec):
+                _specs.pop(part.name, None)
+            raise LookupError(f"cannot register {name!r}: {exc}; register the types it uses "
+                              "first") from None
 
 
 def _same(a: Spec, b: Spec) -> bool:

@@ -26,7 +26,7 @@ _NP = {
 def packages() -> dict[str, list[str]]:
     """Package name -> short interface names (built-in definitions only)."""
     out: dict[str, list[str]] = {}
-    for name in all_names():
+    for name in all_names(registered=False):
         pkg, _, short = name.split("/")
         out.setdefault(pkg, []).append(short)
     return {k: sorted(v) for k, v in sorted(out.items())}
