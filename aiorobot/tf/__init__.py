@@ -8,6 +8,7 @@ transform from frame A to frame B maps coordinates expressed in A into B.
 
 from __future__ import annotations
 
+from ._broadcasters import StaticTransformBroadcaster, TransformBroadcaster
 from ._buffer import Buffer
 from ._buffer_core import BufferCore
 from ._conversions import do_transform
@@ -34,16 +35,24 @@ from ._math import (
     rotate_vectors,
     transform_from_pq,
 )
+from ._listener import TransformListener
+from ._robot_state_publisher import RobotStatePublisher
 from ._urdf import URDFError, UrdfJoint, UrdfModel, load_urdf, parse_urdf
+from ._views import FrameInfo
 
 __all__ = [
     "Buffer",
     "BufferCore",
     "ConnectivityException",
     "ExtrapolationException",
+    "FrameInfo",
     "InvalidArgumentException",
     "LookupException",
+    "RobotStatePublisher",
+    "StaticTransformBroadcaster",
+    "TransformBroadcaster",
     "TransformException",
+    "TransformListener",
     "URDFError",
     "UrdfJoint",
     "UrdfModel",

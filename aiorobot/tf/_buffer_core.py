@@ -25,6 +25,7 @@ from ._exceptions import (
     LookupException,
     TransformException,
 )
+from ._views import FrameInfo, frames_as_dot, frames_as_yaml
 from ._math import IDENTITY_QUAT, Quat, Vec, _canonical, _qinv, _qmul, _qrot
 from ._msgs import make_transform_stamped, time_ns, time_from_ns
 
@@ -561,77 +562,40 @@ class BufferCore:
         with self._lock:
             return self._frames_as_string()
 
-    def _frame_stats(self) -> list[dict[str, Any]]:
-        stats = []
-        for fid in range(1, len(self._names)):
-            cache = self._caches[fid]
-            if cache is None or len(cache) == 0:
-                continue
-            latest = cache.latest_stamp()
-            oldest = cache.oldest_stamp()
-            span_ns = max(latest - oldest, 100_000)
-            stats.append(
-                {
-                    "frame": self._names[fid],
-                    "parent": self._names[self._parent_of(cache)],
-                    "authority": self._authority.get(fid, "no recorded authority"),
-                    "rate_hz": len(cache) * 1e9 / span_ns,
-                    "latest_ns": latest,
-                    "oldest_ns": oldest,
-                    "static": cache.is_static,
-                }
-            )
-        return stats
+    def frame_infos(self) -> list[FrameInfo]:
+        """One :class:`FrameInfo` per frame that has data: parent, authority, rate, stamps."""
+        with self._lock:
+            infos = []
+            for fid in range(1, len(self._names)):
+                cache = self._caches[fid]
+                if cache is None or len(cache) == 0:
+                    continue
+                latest = cache.latest_stamp()
+                oldest = cache.oldest_stamp()
+                infos.append(
+                    FrameInfo(
+                        frame=self._names[fid],
+                        parent=self._names[self._parent_of(cache)],
+                        authority=self._authority.get(fid, "no recorded authority"),
+                        # tf2's figure: samples over the span, the span at least 100 us
+                        rate_hz=len(cache) * 1e9 / max(latest - oldest, 100_000),
+                        latest_ns=latest,
+                        oldest_ns=oldest,
+                        static=cache.is_static,
+                    )
+                )
+            return infos
 
     def all_frames_as_yaml(self, current_time: Any = None) -> str:
         """tf2's YAML view: per frame its parent, broadcaster, rate and data span."""
         now = time_ns(current_time) if current_time is not None else 0
-        with self._lock:
-            stats = self._frame_stats()
-        if not stats:
-            return "[]"
-        out = []
-        for s in stats:
-            out.append(f"{s['frame']}: \n")
-            out.append(f"  parent: '{s['parent']}'\n")
-            out.append(f"  broadcaster: '{s['authority']}'\n")
-            out.append(f"  rate: {s['rate_hz']:.3f}\n")
-            out.append(f"  most_recent_transform: {display_time(s['latest_ns'])}\n")
-            out.append(f"  oldest_transform: {display_time(s['oldest_ns'])}\n")
-            if now:
-                out.append(f"  transform_delay: {(now - s['latest_ns']) / 1e9:.3f}\n")
-            out.append(f"  buffer_length: {(s['latest_ns'] - s['oldest_ns']) / 1e9:.3f}\n")
-        return "".join(out)
+        return frames_as_yaml(self.frame_infos(), now)
 
     def to_dot(self, current_time: Any = None) -> str:
         """Graphviz text of the tree: one edge per link, labelled with the publishing
         authority, the average rate and the latest stamp (``static`` for static links)."""
         now = time_ns(current_time) if current_time is not None else 0
-        with self._lock:
-            stats = self._frame_stats()
-            names = self._names[1:]
-        lines = ["digraph G {"]
-        if not stats:
-            lines.append('"no tf data received";')
-        for name in names:
-            lines.append(f'"{_dot_escape(name)}";')
-        for s in stats:
-            if s["static"]:
-                timing = "static"
-            else:
-                timing = (
-                    f"Average rate: {s['rate_hz']:.3f} Hz\\n"
-                    f"Most recent transform: {display_time(s['latest_ns'])}"
-                )
-                if now:
-                    timing += f" ({(now - s['latest_ns']) / 1e9:.3f} sec old)"
-                timing += f"\\nBuffer length: {(s['latest_ns'] - s['oldest_ns']) / 1e9:.3f} sec"
-            lines.append(
-                f'"{_dot_escape(s["parent"])}" -> "{_dot_escape(s["frame"])}" '
-                f'[label="Broadcaster: {_dot_escape(s["authority"])}\\n{timing}"];'
-            )
-        lines.append("}")
-        return "\n".join(lines) + "\n"
+        return frames_as_dot(self.frame_infos(), self.get_all_frame_names(), now)
 
 
 def check_frame_id_syntax(frame_id: Any, where: str) -> None:
@@ -651,6 +615,3 @@ def check_frame_id_syntax(frame_id: Any, where: str) -> None:
             f"with a '/'; use \"{frame_id.lstrip('/')}\""
         )
 
-
-def _dot_escape(text: str) -> str:
-    return text.replace("\\", "\\\\").replace('"', '\\"')
