@@ -140,7 +140,10 @@ def _install(spec: Spec) -> None:
 
 def _owner(name: str) -> str:
     """``pkg/srv/X_Request`` -> ``pkg/srv/X``; ``pkg/action/X_SendGoal_Request`` -> ``pkg/action/X``."""
-    pkg, kind, short = name.split("/")
+    parts = name.split("/")
+    if len(parts) != 3:
+        return name
+    pkg, kind, short = parts
     if kind == "srv":
         for suffix in ("_Request", "_Response", "_Event"):
             if short.endswith(suffix):
@@ -219,7 +222,11 @@ def get_spec(name: str) -> Spec:
         if spec is None:
             spec = _load_builtin(full)
     if spec is None:
-        close = difflib.get_close_matches(full, all_names(), n=3, cutoff=0.8)
+        names = all_names()
+        if full.count("/") != 2:  # e.g. "Twist": offer the types of that name
+            close = [n for n in names if n.rsplit("/", 1)[-1] == full.rsplit("/", 1)[-1]][:3]
+        else:
+            close = difflib.get_close_matches(full, names, n=3, cutoff=0.8)
         hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else (
             "; register it with aiorobot.msgs.register_msg/register_srv/register_action/"
             "register_file")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import ast
+
 import pytest
 
 import aiorobot.msgs as msgs
@@ -74,3 +76,4 @@ def test_generated_package_modules_and_stubs_are_up_to_date() -> None:
 
     for path, text in generate(write=False).items():
         assert path.read_text() == text, f"{path.name} is stale: run python -m aiorobot.msgs._stubgen"
+        ast.parse(text, filename=path.name)

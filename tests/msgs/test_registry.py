@@ -35,6 +35,9 @@ def test_get_of_an_unknown_name_suggests_close_names() -> None:
     with pytest.raises(LookupError, match=r"unknown interface type 'nope_msgs/msg/Nothing'; "
                                           r"register it with"):
         msgs.get("nope_msgs/msg/Nothing")
+    with pytest.raises(LookupError, match=r"^unknown interface type 'Twist'; did you mean "
+                                          r"'geometry_msgs/msg/Twist'\?$"):
+        msgs.get("Twist")
 
 
 def test_parts_of_services_and_actions_are_found_by_name() -> None:
