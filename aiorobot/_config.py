@@ -36,6 +36,7 @@ __all__ = [
     "RecordConfig",
     "RuntimeConfig",
     "TRANSPORTS",
+    "build_nodes",
     "load_config",
     "parse_config",
 ]
@@ -179,6 +180,16 @@ def load_config(path: str | Path) -> GraphConfig:
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(path, None, _toml_error_message(str(err), text)) from None
     return parse_config(data, path)
+
+
+def build_nodes(config: GraphConfig) -> list[tuple[Any, str]]:
+    """Import the node classes of ``config`` and construct the nodes: ``[(node, executor), ...]``.
+
+    See :func:`aiorobot._config_build.build_nodes` (imported lazily: this module stays pure).
+    """
+    from ._config_build import build_nodes as _build_nodes
+
+    return _build_nodes(config)
 
 
 def parse_config(data: Mapping[str, Any], path: str | Path = "<config>") -> GraphConfig:

@@ -122,7 +122,7 @@ def _module_not_found(module_name: str, missing: str, config: GraphConfig) -> st
         except Exception:  # noqa: BLE001 - a suggestion is a nicety, never an error
             siblings = []
     close = difflib.get_close_matches(leaf, siblings, n=1)
-    hint = f' (did you mean "{parent}.{close[0]}"?)' if close else ""
+    hint = f' (did you mean "{parent + "." if parent else ""}{close[0]}"?)' if close else ""
     where = "" if missing != module_name else f" on the Python path or in {config.base_dir}"
     found = f'module "{module_name}" was not found' if missing == module_name else (
         f'module "{module_name}" was not found: there is no "{missing}"'
@@ -197,7 +197,7 @@ def _check_signature(
             node_config.key,
             f"expected {cls.__name__}.__init__ to accept {' and '.join(missing)} (write "
             f'"def __init__(self, **kw): super().__init__("name", **kw)"), found '
-            f"{cls.__name__}{signature}",
+            f"{cls.__name__}{signature.replace(return_annotation=inspect.Signature.empty)}",
         )
 
 

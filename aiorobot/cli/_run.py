@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import logging
 import signal
 import sys
 from pathlib import Path
@@ -16,6 +17,7 @@ from typing import TYPE_CHECKING
 from ._parser import positive_seconds
 
 if TYPE_CHECKING:
+    from aiorobot import Runtime
     from aiorobot._config import GraphConfig
 
 __all__ = ["add_arguments", "main"]
@@ -100,9 +102,10 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
             domain_id=runtime_config.domain_id,
             use_sim_time=runtime_config.use_sim_time,
             strict_qos=runtime_config.strict_qos,
+            handle_signals=False,  # ours stay installed until the runtime has fully shut down
         ) as rt:
             for signum in signals:
-                loop.add_signal_handler(signum, rt.shutdown)
+                loop.add_signal_handler(signum, _on_signal, rt, signum)
             for node, executor in nodes:
                 rt.add_node(node, executor=executor)
             async with StatusDisplay([node for node, _ in nodes], period_sec=status_period_sec):
@@ -111,3 +114,9 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
         for signum in signals:
             loop.remove_signal_handler(signum)
     return 0
+
+
+def _on_signal(rt: Runtime, signum: int) -> None:
+    if not rt.is_shutdown:
+        logging.getLogger("aiorobot.cli").info(f"{signal.Signals(signum).name} received: shutting down")
+    rt.shutdown()
