@@ -169,6 +169,7 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
     lines = [
         f"class {spec.short_name}(_Message):",
         f"    __slots__ = {tuple(names)!r}",
+        f"    __match_args__ = {tuple(names)!r}",
         f"    __msgtype__ = {spec.name!r}",
     ]
     lines += [f"    {c.name} = {c.value!r}" for c in spec.constants]

@@ -195,7 +195,10 @@ def _strip_comment(line: str) -> str:
 def _unquote(text: str) -> str:
     text = text.strip()
     if len(text) >= 2 and text[0] == text[-1] and text[0] in "\"'":
-        return text[1:-1].encode().decode("unicode_escape")
+        inner = text[1:-1]
+        if "\\" in inner:  # decode escapes, keeping non-ASCII characters intact
+            inner = inner.encode("latin-1", "backslashreplace").decode("unicode_escape")
+        return inner
     return text
 
 

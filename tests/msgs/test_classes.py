@@ -180,3 +180,13 @@ def test_time_to_msg_builds_builtin_interfaces_time() -> None:
 
     msg = aiorobot.Time(seconds=3, nanoseconds=5).to_msg()
     assert msg == Time(sec=3, nanosec=5)
+
+
+def test_messages_support_positional_pattern_matching() -> None:
+    from aiorobot.msgs.geometry_msgs import Vector3
+
+    match Vector3(1.0, 2.0, 3.0):
+        case Vector3(x, y, z):
+            assert (x, y, z) == (1.0, 2.0, 3.0)
+        case _:
+            pytest.fail("Vector3 did not match")

@@ -251,3 +251,16 @@ def test_every_package_module_lists_buildable_types() -> None:
         assert module.__all__ == names
         for name in names:
             assert getattr(module, name).__msgtype__.split("/")[2] == name
+
+
+def test_string_constants_and_defaults_keep_unicode_and_decode_escapes() -> None:
+    cls = msgs.register_msg('string GREETING="héllo\\tworld"\nstring name "Zoë"\nbool on true',
+                            "test_registry_msgs/msg/Greeting")
+    assert cls.GREETING == "héllo\tworld"
+    assert cls().name == "Zoë" and cls().on is True
+
+
+def test_shipped_definitions_keep_upstream_defaults() -> None:
+    from aiorobot.msgs.type_description_interfaces import GetTypeDescription
+
+    assert GetTypeDescription.Request().include_type_sources is True
