@@ -87,7 +87,8 @@ def main(args: argparse.Namespace) -> int:
 
 
 async def _serve(config: GraphConfig, duration_sec: float | None, status_period_sec: float) -> int:
-    from aiorobot import Runtime
+    from aiorobot import QoSIncompatibleError, Runtime
+    from aiorobot._config import ConfigError
     from aiorobot._config_build import build_nodes
 
     from ._status import StatusDisplay
@@ -106,8 +107,11 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
         ) as rt:
             for signum in signals:
                 loop.add_signal_handler(signum, _on_signal, rt, signum)
-            for node, executor in nodes:
-                rt.add_node(node, executor=executor)
+            for node_config, (node, executor) in zip(config.nodes, nodes, strict=True):
+                try:
+                    rt.add_node(node, executor=executor)
+                except QoSIncompatibleError as err:  # strict_qos: the graph as written cannot connect
+                    raise ConfigError(config.path, node_config.key, f"runtime.strict_qos is set and {err}") from None
             async with StatusDisplay([node for node, _ in nodes], period_sec=status_period_sec):
                 await rt.spin(duration_sec=duration_sec)
     finally:  # kept until the runtime has shut down: a second Ctrl-C must not interrupt that
