@@ -90,6 +90,7 @@ class SerialMotorBridge(Node):
         self._reported_bad = 0
         self.feedback_published = 0
         self.commands_sent = 0
+        self._shutting_down = False
 
         from aiorobot.msgs.sensor_msgs import JointState
         from aiorobot.msgs.std_msgs import Bool
@@ -113,6 +114,7 @@ class SerialMotorBridge(Node):
         self._try_connect(time.monotonic())
 
     async def on_shutdown(self) -> None:
+        self._shutting_down = True
         if self.link.connected:
             self.link.send(SetWheelVelocities((0.0,) * len(self.joint_names)))
             self.link.flush_now()
@@ -135,6 +137,9 @@ class SerialMotorBridge(Node):
 
     def _on_disconnect(self, exc: BaseException) -> None:
         self.firmware_alive = False
+        if self._shutting_down:
+            self.get_logger().info(f"{self.port} closed during shutdown: {exc}")
+            return
         self.get_logger().error(f"lost {self.port}: {exc}; reconnecting every {self.reconnect_period_sec} s")
 
     @staticmethod
@@ -144,6 +149,8 @@ class SerialMotorBridge(Node):
     # -- periodic: heartbeat, watchdog, reconnect, bad-frame report -----------------------
 
     def on_heartbeat_timer(self) -> None:
+        if self._shutting_down:
+            return
         now = time.monotonic()
         if not self.link.connected:
             if now - self._last_attempt >= self.reconnect_period_sec:

@@ -345,18 +345,25 @@ class PtyFirmware:
     async def __aexit__(self, *exc: object) -> None:
         await self.close()
 
-    def _on_readable(self) -> None:
+    def _on_readable(self) -> bool:
+        """Read one chunk from the master side into the firmware; False when nothing was there."""
         if self._master is None:
-            return
+            return False
         try:
             data = os.read(self._master, 4096)
         except BlockingIOError:
-            return
+            return False
         except OSError as exc:
             if exc.errno == errno.EIO:  # no slave open right now
-                return
+                return False
             raise
         self.firmware.receive(data, self._clock())
+        return bool(data)
+
+    def drain(self) -> None:
+        """Take in everything the host has written so far (before closing, say)."""
+        while self._on_readable():
+            pass
 
     async def _run(self) -> None:
         while True:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 from typing import Any
 
 from aiorobot import Node
@@ -47,5 +48,17 @@ class SimulatedFirmwareNode(Node):
         if self.pty.is_open:
             self.pty.pump()
 
+    def summary(self) -> str:
+        fw = self.firmware
+        stats = fw.decoder.statistics()
+        return (
+            f"{self.get_name()}: {fw.commands_received} wheel commands, {stats.frames_ok} frames from the host "
+            f"({stats.bad_frames} bad), final status {fw.status!r}"
+        )
+
     async def on_shutdown(self) -> None:
+        # yield once so shutdown hooks of nodes on this loop (a bridge's last zero command) run first,
+        # then take in what they wrote before the device disappears
+        await asyncio.sleep(0)
+        self.pty.drain()
         self.pty.close_pty()
