@@ -31,6 +31,9 @@ class SimulatedFirmwareNode(Node):
             host_timeout_sec=p("host_timeout_sec", 0.5, description="hold motors without host heartbeat", range=(0.01, 60.0)).value,
             ticks_period_sec=1.0 / p("ticks_rate_hz", 50.0, description="encoder report rate", range=(1.0, 1000.0)).value,
         )
+        self.linger_sec = p(
+            "linger_sec", 0.1, description="keep serving this long during shutdown", range=(0.0, 5.0)
+        ).value
         rate_hz = p("rate_hz", 200.0, description="simulation step rate", range=(10.0, 2000.0)).value
         self.pty = PtyFirmware(firmware, link_path=self.port_link, period_sec=1.0 / rate_hz)
         self.create_timer(1.0 / rate_hz, self.on_tick)
@@ -57,8 +60,12 @@ class SimulatedFirmwareNode(Node):
         )
 
     async def on_shutdown(self) -> None:
-        # yield once so shutdown hooks of nodes on this loop (a bridge's last zero command) run first,
-        # then take in what they wrote before the device disappears
-        await asyncio.sleep(0)
-        self.pty.drain()
+        # Linger: keep reading for a moment so what other nodes send from their own shutdown
+        # hooks (a bridge's last zero command) still reaches the firmware, then unplug.
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + self.linger_sec
+        while loop.time() < deadline:
+            await asyncio.sleep(0.01)
+            self.pty.drain()
+            self.pty.pump()
         self.pty.close_pty()

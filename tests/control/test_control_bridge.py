@@ -214,3 +214,22 @@ async def test_bridge_stops_the_motors_on_shutdown(tmp_path):
             probe.wheel_pub.publish(wheels)
             await wait_until(lambda: np.all(firmware.target_rad_s == 2.0))
         await wait_until(lambda: not np.any(firmware.target_rad_s))
+
+
+async def test_simulated_firmware_node_receives_the_bridge_zero_command_at_shutdown(tmp_path):
+    path = str(tmp_path / "ttyMOTORS")
+    firmware_node = SimulatedFirmwareNode(parameter_overrides={"port_link": path})
+    async with Runtime() as rt:
+        bridge = bridge_for(path)
+        probe = Probe()
+        rt.add_node(firmware_node)
+        rt.add_node(bridge)
+        rt.add_node(probe)
+        await wait_until(lambda: bridge.firmware_alive)
+        wheels = JointState()
+        wheels.name = JOINTS
+        wheels.velocity = np.full(4, 2.5)
+        probe.wheel_pub.publish(wheels)
+        await wait_until(lambda: np.all(firmware_node.firmware.target_rad_s == 2.5))
+    assert not np.any(firmware_node.firmware.target_rad_s)
+    assert not (tmp_path / "ttyMOTORS").exists()
