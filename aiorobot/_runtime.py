@@ -327,9 +327,8 @@ class Runtime:
         nodes = list(self._nodes)
         # 1. on_shutdown hooks, each on its node's loop (controllers send their last command here).
         if nodes:
-            hooks = [
-                self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown")) for n in nodes if n._started
-            ]
+            # Scheduled after each node's _start on the same loop, so every hook sees a started node.
+            hooks = [self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown")) for n in nodes]
             done, pending = await asyncio.wait(
                 [asyncio.ensure_future(h) for h in hooks] or [asyncio.ensure_future(asyncio.sleep(0))],
                 timeout=SHUTDOWN_HOOK_TIMEOUT_SEC,

@@ -116,6 +116,8 @@ class Timer:
     def reset(self) -> None:
         """Restart the period from now (and resume a cancelled timer), as rclpy's ``reset``."""
         self._cancelled = False
+        if self.node._loop is not None:
+            self._next_ns = self._now() + self.period_ns
         self._restart = True
         self.node._call_soon(self._poke)
 
@@ -128,6 +130,8 @@ class Timer:
 
     def _start(self) -> None:
         if self._task is None and not self.destroyed:
+            self._next_ns = self._now() + self.period_ns
+            self._restart = False
             self._task = self.node._create_task(self._run(), name=f"timer {self.period_ns / 1e9:g}s of {self.node.get_fully_qualified_name()}")
 
     def _now(self) -> int:
@@ -152,7 +156,6 @@ class Timer:
     async def _run(self) -> None:
         node = self.node
         loop = node._loop
-        self._next_ns = self._now() + self.period_ns
         while True:
             if self._cancelled:
                 wake = loop.create_future()
@@ -162,9 +165,7 @@ class Timer:
                 finally:
                     self._wake = None
                 continue
-            if self._restart:
-                self._restart = False
-                self._next_ns = self._now() + self.period_ns
+            self._restart = False
             deadline = self._next_ns
             assert deadline is not None
             try:
@@ -219,7 +220,8 @@ class Rate:
             raise ValueError(f"rate: expected a frequency in Hz > 0, got {frequency!r}")
         self.node = node
         self.period_ns = round(1e9 / frequency)
-        self._next_ns: int | None = None
+        # The grid starts at creation, as ROS's Rate; a node not yet running starts it at the first sleep.
+        self._next_ns: int | None = self._now() + self.period_ns if node._loop is not None else None
 
     def __repr__(self) -> str:
         return f"<Rate {1e9 / self.period_ns:g} Hz of {self.node.get_fully_qualified_name()}>"

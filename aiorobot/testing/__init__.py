@@ -1,5 +1,21 @@
-"""Helpers for testing aiorobot nodes with pytest-asyncio."""
+"""Testing aiorobot nodes with pytest-asyncio.
+
+The pytest plugin (registered through the ``pytest11`` entry point, so nothing
+to configure) provides the fixtures ``runtime`` (a fresh local ``Runtime`` per
+test, shut down after it), ``sim_runtime`` (the same with ``use_sim_time``) and
+``sim_clock`` (a :class:`SimClock` on ``sim_runtime``)::
+
+    async def test_talker_publishes(runtime):
+        probe = runtime.add_node(aiorobot.Node("probe"))
+        runtime.add_node(Talker())
+        msg = await wait_for_message(probe, Twist, "/cmd_vel", timeout_sec=5)
+        assert msg.linear.x == 0.0
+"""
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from ._settle import settle
+from ._sim import ClockPublisher, SimClock
+from ._wait import wait_for_message
+
+__all__ = ["ClockPublisher", "SimClock", "settle", "wait_for_message"]
