@@ -149,6 +149,7 @@ def test_console_script_runs_the_cli() -> None:
     assert result.returncode == 0 and "usage: aiorobot" in result.stdout
 
 
+@pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
 def test_bundled_example_runs_for_duration_and_exits_0() -> None:
     result = aiorobot("run", "--duration", "3")
     assert result.returncode == 0, result.stderr
@@ -188,6 +189,7 @@ USER_NODES = textwrap.dedent(
 )
 
 
+@pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
 def test_user_module_is_loaded_from_the_config_folder(tmp_path: Path) -> None:
     graph = tmp_path / "robot"
     graph.mkdir()
@@ -205,6 +207,7 @@ def test_user_module_is_loaded_from_the_config_folder(tmp_path: Path) -> None:
     assert "greeter sent some greetings" in result.stdout.splitlines()
 
 
+@pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_signal_stops_a_running_graph_cleanly(signum: signal.Signals) -> None:
     proc = subprocess.Popen(
