@@ -266,3 +266,46 @@ def test_strict_qos_mismatch_in_config_graph_is_a_one_line_config_error(tmp_path
     assert line.startswith(f"{config}: nodes[1]: runtime.strict_qos is set and incompatible QoS on /chatter: ")
     assert "/talker" in line and "/listener" in line
     assert result.stdout == "", "spin never started"
+
+
+LOGGING_NODES = textwrap.dedent(
+    '''
+    from aiorobot import Node
+
+
+    class Chatty(Node):
+        def __init__(self, **kw):
+            super().__init__("chatty", **kw)
+            self.create_timer(0.05, self.tick)
+
+        async def tick(self):
+            self.get_logger().debug("chatty debug line", once=True)
+            self.get_logger().info("chatty info line", once=True)
+
+
+    class Quiet(Chatty):
+        def __init__(self, **kw):
+            super().__init__(**kw)
+
+        async def tick(self):
+            self.get_logger().info("quiet info line", once=True)
+            self.get_logger().warning("quiet warning line", once=True)
+    '''
+)
+
+
+def test_log_levels_from_config_apply_runtime_wide_and_per_node(tmp_path: Path) -> None:
+    (tmp_path / "log_nodes.py").write_text(LOGGING_NODES, encoding="utf-8")
+    config = tmp_path / "logs.toml"
+    config.write_text(
+        '[runtime]\nlog_level = "warning"\n'
+        '[[nodes]]\nuse = "log_nodes:Chatty"\nlog_level = "debug"\n'
+        '[[nodes]]\nname = "quiet"\nuse = "log_nodes:Quiet"\n',
+        encoding="utf-8",
+    )
+    result = aiorobot("run", str(config), "--duration", "1.5")
+    assert result.returncode == 0, result.stderr
+    assert "[DEBUG]" in result.stderr and "[/chatty]: chatty debug line" in result.stderr
+    assert "[/chatty]: chatty info line" in result.stderr
+    assert "[/quiet]: quiet warning line" in result.stderr
+    assert "quiet info line" not in result.stderr, "the runtime-wide level is warning"
