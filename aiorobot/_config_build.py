@@ -111,22 +111,23 @@ def _import_module(config: GraphConfig, key: str, module_name: str) -> ModuleTyp
 
 
 def _module_not_found(module_name: str, missing: str, config: GraphConfig) -> str:
+    """Explain which part of a dotted module path is missing, with a close existing name."""
     parent, _, leaf = missing.rpartition(".")
-    siblings: list[str] = []
-    if not parent:  # a top-level module: suggest from the config's folder
-        siblings = [m.name for m in pkgutil.iter_modules([str(config.base_dir)])]
-    else:
+    if parent:
         try:
             package = importlib.import_module(parent)
             siblings = [m.name for m in pkgutil.iter_modules(getattr(package, "__path__", []))]
         except Exception:  # noqa: BLE001 - a suggestion is a nicety, never an error
             siblings = []
+        where = ""
+    else:  # a top-level module: suggest from the config's folder
+        siblings = [m.name for m in pkgutil.iter_modules([str(config.base_dir)])]
+        where = f" on the Python path or in {config.base_dir}"
     close = difflib.get_close_matches(leaf, siblings, n=1)
     hint = f' (did you mean "{parent + "." if parent else ""}{close[0]}"?)' if close else ""
-    where = "" if missing != module_name else f" on the Python path or in {config.base_dir}"
-    found = f'module "{module_name}" was not found' if missing == module_name else (
-        f'module "{module_name}" was not found: there is no "{missing}"'
-    )
+    found = f'module "{module_name}" was not found'
+    if missing != module_name:
+        found += f': there is no "{missing}"'
     return f"expected an importable module{where}, but {found}{hint}"
 
 
