@@ -9,7 +9,8 @@ Serial motor protocol (``docs/serial-protocol.md``): framing (:func:`encode_mess
 (:class:`SimulatedFirmware`, :class:`PtyFirmware`).
 
 Nodes: :class:`DiffDriveController`, :class:`MecanumController`,
-:class:`SerialMotorBridge`, :class:`SimulatedFirmwareNode`.
+:class:`SerialMotorBridge`, :class:`SimulatedFirmwareNode`, :class:`GoToGoalController`,
+:class:`PurePursuitController`.
 """
 
 from __future__ import annotations
@@ -67,10 +68,15 @@ _NODES = {
     "odometry_message": "._base_controller",
     "SerialMotorBridge": "._serial_bridge",
     "SimulatedFirmwareNode": "._sim_firmware_node",
+    "GoToGoalController": "._follower_nodes",
+    "PurePursuitController": "._follower_nodes",
+    "path_from_msg": "._follower_nodes",
+    "pose_from_msg": "._follower_nodes",
 }
 
 if TYPE_CHECKING:
     from ._base_controller import BaseController, DiffDriveController, MecanumController, odometry_message
+    from ._follower_nodes import GoToGoalController, PurePursuitController, path_from_msg, pose_from_msg
     from ._serial_bridge import SerialMotorBridge
     from ._sim_firmware_node import SimulatedFirmwareNode
 
@@ -107,6 +113,7 @@ __all__ = [
     "FrameError",
     "FrameErrorKind",
     "GoToGoal",
+    "GoToGoalController",
     "HostHeartbeat",
     "integrate_twist",
     "Kinematics",
@@ -122,10 +129,13 @@ __all__ = [
     "odometry_message",
     "Packet",
     "parse_packet",
+    "path_from_msg",
     "PID",
+    "pose_from_msg",
     "PROTOCOL_VERSION",
     "PtyFirmware",
     "PurePursuit",
+    "PurePursuitController",
     "ResetEncoders",
     "saturate_wheel_speeds",
     "SerialLink",

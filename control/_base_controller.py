@@ -129,17 +129,16 @@ class BaseController(Node):
         self.create_subscription(Twist, "/cmd_vel", self.on_cmd_vel, 10)
         self.create_subscription(JointState, "/joint_states", self.on_joint_states, 10)
         self.timer = self.create_timer(1.0 / self.rate_hz, self.on_tick)
-
-    def _make_kinematics(self) -> Kinematics:
-        raise NotImplementedError("subclasses build their kinematics")
-
-    async def on_start(self) -> None:
         if self.publish_tf:
             import aiorobot.tf as tf
 
             broadcaster = getattr(tf, "TransformBroadcaster", None)
             if broadcaster is not None:
                 self._tf_broadcaster = broadcaster(self)
+
+    def _make_kinematics(self) -> Kinematics:
+        raise NotImplementedError("subclasses build their kinematics")
+
 
     # -- command path ------------------------------------------------------------------
 

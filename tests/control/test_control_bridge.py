@@ -178,7 +178,7 @@ async def test_estop_topic_latches_and_clears_the_firmware(tmp_path):
             await wait_until(lambda: np.all(firmware.target_rad_s == 1.0))
 
 
-async def test_bad_frames_are_counted_without_losing_the_link(tmp_path):
+async def test_bad_frames_are_counted_without_losing_the_link(tmp_path, caplog):
     path = str(tmp_path / "ttyMOTORS")
     async with PtyFirmware(SimulatedFirmware(), link_path=path) as fw:
         async with Runtime() as rt:
@@ -197,6 +197,7 @@ async def test_bad_frames_are_counted_without_losing_the_link(tmp_path):
             decoder = bridge.statistics().decoder
             assert decoder.oversize == 1 and decoder.truncated >= 1 and decoder.crc_errors >= 1
             assert bridge.link.connected
+            await wait_until(lambda: any("bad frames from" in r.getMessage() for r in caplog.records))
 
 
 async def test_bridge_stops_the_motors_on_shutdown(tmp_path):

@@ -58,7 +58,7 @@ def twist(vx=0.0, vy=0.0, wz=0.0):
 
 
 @pytest.mark.parametrize("executor", ["main", "priority"])
-async def test_watchdog_zeroes_wheels_when_cmd_vel_stops(executor):
+async def test_watchdog_zeroes_wheels_when_cmd_vel_stops(executor, caplog):
     async with Runtime() as rt:
         controller = DiffDriveController(
             parameter_overrides={"cmd_timeout_sec": 0.2, "max_accel_x": 100.0, "wheel_radius": 0.1}
@@ -77,6 +77,9 @@ async def test_watchdog_zeroes_wheels_when_cmd_vel_stops(executor):
         count = len(probe.wheel_commands)
         await wait_until(lambda: len(probe.wheel_commands) > count + 5)
         assert not np.any(np.stack(probe.wheel_commands[count:]))
+        warnings = [r for r in caplog.records if "no /cmd_vel for more than cmd_timeout_sec=0.2 s" in r.getMessage()]
+        assert len(warnings) == 1  # throttled, not one per tick
+        assert warnings[0].levelname == "WARNING"
 
 
 async def test_commands_keep_flowing_while_cmd_vel_arrives():
@@ -171,3 +174,26 @@ async def test_odometry_of_a_turn_on_the_spot():
 def test_controller_rejects_wrong_number_of_joint_names():
     with pytest.raises(ValueError, match=r"^joint_names must name 4 wheels for Mecanum, got 2: \['a', 'b'\]$"):
         MecanumController(parameter_overrides={"joint_names": ["a", "b"]})
+
+
+async def test_odometry_is_broadcast_as_odom_to_base_link_on_tf():
+    from aiorobot.msgs.tf2_msgs import TFMessage
+
+    async with Runtime() as rt:
+        controller = DiffDriveController(parameter_overrides={"wheel_radius": 0.1, "base_frame_id": "base_footprint"})
+        probe = Probe()
+        transforms = []
+        probe.create_subscription(TFMessage, "/tf", lambda m: transforms.extend(m.transforms), 100)
+        rt.add_node(controller, executor="priority")
+        rt.add_node(probe)
+        for i, angle in enumerate([0.0, 5.0]):
+            msg = JointState()
+            msg.header.stamp.sec = 1 + i
+            msg.name = ["left_wheel_joint", "right_wheel_joint"]
+            msg.position = np.array([angle, angle])
+            probe.joint_pub.publish(msg)
+        await wait_until(lambda: len(transforms) == 2)
+        t = transforms[-1]
+        assert (t.header.frame_id, t.child_frame_id) == ("odom", "base_footprint")
+        assert t.transform.translation.x == pytest.approx(0.5)
+        assert t.header.stamp.sec == 2
