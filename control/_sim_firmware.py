@@ -277,6 +277,11 @@ class PtyFirmware:
         """Create the pty (and the link) now, without serving yet: the port exists from here on."""
         if self._master is not None:
             raise RuntimeError(f"{self!r} is already open")
+        if self.link_path and os.path.lexists(self.link_path) and not os.path.islink(self.link_path):
+            raise FileExistsError(
+                f"link_path {self.link_path!r} exists and is not a symlink; PtyFirmware only replaces "
+                "its own links, so pick a free path such as /tmp/aiorobot-sim-motors"
+            )
         master, slave = os.openpty()
         tty.setraw(slave)
         os.set_blocking(master, False)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -22,9 +23,15 @@ def _runtime_available() -> bool:
 
 
 @pytest.mark.skipif(not _runtime_available(), reason="needs the runtime and the aiorobot CLI")
-def test_mecanum_serial_example_drives_the_square_and_prints_odometry():
+def test_mecanum_serial_example_drives_the_square_and_prints_odometry(tmp_path):
+    # the example as shipped, with its pty link moved into tmp_path so parallel runs do not share it
+    text = EXAMPLE.read_text()
+    assert text.count("/tmp/aiorobot-mecanum-serial") == 2
+    config = tmp_path / "mecanum_serial.toml"
+    config.write_text(text.replace("/tmp/aiorobot-mecanum-serial", str(tmp_path / "ttyMOTORS")))
+    shutil.copy(EXAMPLE.parent / "square_cmd_vel.py", tmp_path / "square_cmd_vel.py")
     result = subprocess.run(
-        [sys.executable, "-m", "aiorobot.cli", "run", str(EXAMPLE), "--duration", "3"],
+        [sys.executable, "-m", "aiorobot.cli", "run", str(config), "--duration", "3"],
         capture_output=True,
         text=True,
         timeout=50,

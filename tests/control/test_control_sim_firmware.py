@@ -121,3 +121,11 @@ async def test_pty_firmware_talks_to_pyserial_on_the_slave_device(tmp_path):
         finally:
             port.close()
     assert not (tmp_path / "ttyROBOT").exists()
+
+
+async def test_pty_firmware_refuses_to_replace_a_file_that_is_not_its_link(tmp_path):
+    precious = tmp_path / "ttyUSB0"
+    precious.write_text("not a link")
+    with pytest.raises(FileExistsError, match=r"exists and is not a symlink; PtyFirmware only replaces its own links"):
+        await PtyFirmware(link_path=str(precious)).start()
+    assert precious.read_text() == "not a link"
