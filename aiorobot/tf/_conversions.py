@@ -35,8 +35,11 @@ def _xyz(v: Any) -> Vec:
     return (float(v.x), float(v.y), float(v.z))
 
 
-def _xyzw(q: Any) -> Quat:
-    return (float(q.x), float(q.y), float(q.z), float(q.w))
+def _xyzw(q: Any, what: str = "quaternion") -> Quat:
+    out = (float(q.x), float(q.y), float(q.z), float(q.w))
+    if not any(out):
+        raise ValueError(f"the {what} is (0, 0, 0, 0), which is no rotation; the identity is (0, 0, 0, 1)")
+    return out
 
 
 def _apply(t: Vec, q: Quat, p: Vec) -> Vec:
@@ -55,7 +58,7 @@ def _vector(msg: Any, t: Vec, q: Quat, frame_id: str, stamp: Any) -> Any:
 def _pose(msg: Any, t: Vec, q: Quat, frame_id: str, stamp: Any) -> Any:
     pose = msg.pose
     position = _apply(t, q, _xyz(pose.position))
-    orientation = _canonical(_qmul(q, _xyzw(pose.orientation)))
+    orientation = _canonical(_qmul(q, _xyzw(pose.orientation, "pose's orientation")))
     out_pose = type(pose)(
         position=_vec_like(pose.position, position),
         orientation=_quat_like(pose.orientation, orientation),
@@ -65,14 +68,14 @@ def _pose(msg: Any, t: Vec, q: Quat, frame_id: str, stamp: Any) -> Any:
 
 def _quaternion(msg: Any, t: Vec, q: Quat, frame_id: str, stamp: Any) -> Any:
     # as tf2_geometry_msgs: the plain product, no sign normalisation
-    out = _qmul(q, _xyzw(msg.quaternion))
+    out = _qmul(q, _xyzw(msg.quaternion, "quaternion to transform"))
     return type(msg)(header=_header(msg, frame_id, stamp), quaternion=_quat_like(msg.quaternion, out))
 
 
 def _transform(msg: Any, t: Vec, q: Quat, frame_id: str, stamp: Any) -> Any:
     tr = msg.transform
     translation = _apply(t, q, _xyz(tr.translation))
-    rotation = _canonical(_qmul(q, _xyzw(tr.rotation)))
+    rotation = _canonical(_qmul(q, _xyzw(tr.rotation, "transform's rotation")))
     out_tr = type(tr)(
         translation=_vec_like(tr.translation, translation),
         rotation=_quat_like(tr.rotation, rotation),

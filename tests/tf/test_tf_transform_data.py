@@ -118,6 +118,12 @@ def test_transform_stamped_is_rechained_keeping_its_child(robot):
     assert q_of(out) == pytest.approx((0.0, 0.0, 1.0, 0.0))  # canonical sign of a half turn
 
 
+def test_a_zero_orientation_is_refused_with_the_fix(robot):
+    pose = PoseStamped(header=header("base_link", 11), pose=Pose(orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=0.0)))
+    with pytest.raises(ValueError, match=r"^the pose's orientation is \(0, 0, 0, 0\), which is no rotation; the identity is \(0, 0, 0, 1\)$"):
+        robot.transform(pose, "map")
+
+
 def test_unsupported_types_say_which_are_supported(robot):
     with pytest.raises(TypeError, match=r"^cannot transform a geometry_msgs/msg/Twist; supported types are geometry_msgs/msg/PointStamped"):
         robot.transform(Twist(), "map")
