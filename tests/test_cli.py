@@ -309,3 +309,27 @@ def test_log_levels_from_config_apply_runtime_wide_and_per_node(tmp_path: Path) 
     assert "[/chatty]: chatty info line" in result.stderr
     assert "[/quiet]: quiet warning line" in result.stderr
     assert "quiet info line" not in result.stderr, "the runtime-wide level is warning"
+
+
+@pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
+def test_closed_stdout_pipe_stops_the_run_quietly() -> None:
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "aiorobot.cli", "run"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+    )
+    try:
+        assert proc.stdout is not None and proc.stderr is not None
+        assert proc.stdout.readline().startswith("[")  # as `aiorobot run | head -1`
+        proc.stdout.close()
+        stderr = proc.stderr.read()
+        proc.wait(timeout=RUN_TIMEOUT_SEC)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        proc.stderr.close()
+    assert proc.returncode == 0, stderr
+    assert_clean(stderr)

@@ -112,7 +112,10 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
                     rt.add_node(node, executor=executor)
                 except QoSIncompatibleError as err:  # strict_qos: the graph as written cannot connect
                     raise ConfigError(config.path, node_config.key, f"runtime.strict_qos is set and {err}") from None
-            async with StatusDisplay([node for node, _ in nodes], period_sec=status_period_sec):
+            display = StatusDisplay(
+                [node for node, _ in nodes], period_sec=status_period_sec, on_stream_closed=rt.shutdown
+            )
+            async with display:
                 await rt.spin(duration_sec=duration_sec)
     finally:  # kept until the runtime has shut down: a second Ctrl-C must not interrupt that
         for signum in signals:

@@ -3,14 +3,17 @@
 Nodes opt in by duck typing: a node with ``status_line() -> str`` contributes to the
 line printed every period, one with ``summary() -> str`` to the summary at the end.
 The line is a rich ``Live`` display on a terminal, a plain line per period otherwise.
+When the reader of a pipe goes away (``aiorobot run | head``), ``on_stream_closed`` is
+called: ``aiorobot run`` then shuts the runtime down.
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from types import TracebackType
 from typing import Any, TextIO
 
@@ -20,8 +23,17 @@ __all__ = ["StatusDisplay"]
 class StatusDisplay:
     """Async context manager printing ``nodes``' status every ``period_sec`` and a summary on exit."""
 
-    def __init__(self, nodes: Sequence[Any], *, period_sec: float = 1.0, stream: TextIO | None = None) -> None:
+    def __init__(
+        self,
+        nodes: Sequence[Any],
+        *,
+        period_sec: float = 1.0,
+        stream: TextIO | None = None,
+        on_stream_closed: Callable[[], None] | None = None,
+    ) -> None:
         self._nodes = list(nodes)
+        self._on_stream_closed = on_stream_closed
+        self._closed = False
         self._period_sec = period_sec
         self._stream = sys.stdout if stream is None else stream
         self._live: Any = None
@@ -110,7 +122,19 @@ class StatusDisplay:
                 self._write(line)
 
     def _write(self, text: str) -> None:
-        print(text, file=self._stream, flush=True)
+        if self._closed:
+            return
+        try:
+            print(text, file=self._stream, flush=True)
+        except BrokenPipeError:  # `aiorobot run | head`: the reader is gone, stop like `yes | head`
+            self._closed = True
+            with contextlib.suppress(OSError, ValueError):
+                # Point the descriptor at /dev/null so the interpreter's final flush stays quiet.
+                devnull = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(devnull, self._stream.fileno())
+                os.close(devnull)
+            if self._on_stream_closed is not None:
+                self._on_stream_closed()
 
 
 def _call(node: Any, method: str) -> str:
