@@ -333,3 +333,33 @@ def test_closed_stdout_pipe_stops_the_run_quietly() -> None:
         proc.stderr.close()
     assert proc.returncode == 0, stderr
     assert_clean(stderr)
+
+
+@pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
+def test_on_a_terminal_the_status_is_a_live_display_and_exits_cleanly() -> None:
+    leader, follower = os.openpty()
+    env = _env() | {"COLUMNS": "200", "TERM": "xterm"}
+    with subprocess.Popen(
+        [sys.executable, "-m", "aiorobot.cli", "run", "--duration", "2", "--status-period", "0.5"],
+        stdin=subprocess.DEVNULL,
+        stdout=follower,
+        stderr=follower,
+        env=env,
+    ) as proc:
+        os.close(follower)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(leader, 65536)
+            except OSError:  # EIO: every writer has closed the terminal
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        os.close(leader)
+        returncode = proc.wait(timeout=RUN_TIMEOUT_SEC)
+    output = b"".join(chunks).decode("utf-8", "replace")
+    assert returncode == 0, output
+    assert_clean(output)
+    assert "\x1b[?25l" in output, "rich hides the cursor while the Live display runs"
+    assert "imu_monitor: received" in output
