@@ -6,6 +6,15 @@ asyncio-native, with a priority loop for control. See API.md for the contract.
 
 from __future__ import annotations
 
+from ._actions import (
+    ActionClient,
+    ActionServer,
+    CancelResponse,
+    ClientGoalHandle,
+    GoalResponse,
+    GoalStatus,
+    ServerGoalHandle,
+)
 from ._clock import Clock
 from ._errors import (
     InvalidNameError,
@@ -16,7 +25,7 @@ from ._errors import (
     QoSIncompatibleError,
     ServiceError,
 )
-from ._graph import EndpointInfo, Graph, NodeInfo, TopicInfo
+from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ._logging import NodeLogger, setup_logging
 from ._node import Node
@@ -36,6 +45,7 @@ from ._qos import (
     qos_profile_system_default,
 )
 from ._runtime import Runtime, run
+from ._services import Client, Service, ServiceUnavailableError
 from ._time import ClockType, Duration, Time
 from ._timer import Rate, Timer, TimerStatistics
 from ._transport import LocalTransport, Transport
@@ -43,7 +53,15 @@ from ._transport import LocalTransport, Transport
 __version__ = "0.1.0"
 
 __all__ = [
+    "ActionClient",
+    "ActionServer",
+    "CancelResponse",
+    "ClientGoalHandle",
+    "GoalResponse",
+    "GoalStatus",
+    "ServerGoalHandle",
     "CallbackGroup",
+    "Client",
     "Clock",
     "ClockType",
     "DurabilityPolicy",
@@ -72,7 +90,10 @@ __all__ = [
     "ReentrantCallbackGroup",
     "ReliabilityPolicy",
     "Runtime",
+    "Service",
     "ServiceError",
+    "ServiceInfo",
+    "ServiceUnavailableError",
     "SetParametersResult",
     "Subscription",
     "Time",

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from ._errors import QoSIncompatibleError
 from ._pubsub import Endpoint, Publisher, Subscription, Tap
 from ._qos import DurabilityPolicy, incompatibility
+from ._services import ServiceRegistry
 
 if TYPE_CHECKING:
     from ._transport import Transport
@@ -51,6 +52,7 @@ class Bus:
         self.strict_qos = strict_qos
         self._lock = threading.RLock()
         self._topics: dict[str, _Topic] = {}
+        self.services = ServiceRegistry()
         self.transport: Transport | None = None
 
     def __repr__(self) -> str:

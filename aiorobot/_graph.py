@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from ._bus import Incompatibility
 from ._qos import QoSProfile
 
-__all__ = ["EndpointInfo", "Graph", "NodeInfo", "TopicInfo"]
+__all__ = ["EndpointInfo", "Graph", "NodeInfo", "ServiceInfo", "TopicInfo"]
 
 
 @dataclass(frozen=True, slots=True)

@@ -17,6 +17,7 @@ import threading
 from collections.abc import Awaitable, Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from ._actions import ActionClient, ActionServer
 from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 from ._logging import NodeLogger
@@ -30,6 +31,7 @@ from ._parameters import (
 )
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile
+from ._services import Client, Service
 from ._time import Time
 from ._timer import Rate, Timer
 from ._waker import LoopWaker, TimerFdWaker
@@ -81,6 +83,8 @@ class Node:
         self._publishers: list[Publisher[Any]] = []
         self._subscriptions: list[Subscription[Any]] = []
         self._timers: list[Timer] = []
+        self._services: list[Service] = []
+        self._clients: list[Client] = []
         self._tasks: set[asyncio.Task[Any]] = set()
         # Bound by Runtime.add_node:
         self._runtime: Runtime | None = None
@@ -246,6 +250,75 @@ class Node:
         if timer._task is not None:
             timer._task.cancel()
 
+    def create_service(
+        self,
+        srv_type: Any,
+        name: str,
+        handler: Callable[[Any], Any],
+        *,
+        callback_group: CallbackGroup | None = None,
+    ) -> Service:
+        """Serve ``name`` with ``handler(request) -> response`` (async or sync).
+
+        A handler that raises answers the caller with :class:`ServiceError` carrying the reason.
+        """
+        service = Service(
+            self, srv_type, self.resolve_topic_name(name, kind="service"), handler, callback_group or self._default_group
+        )
+        self._services.append(service)
+        if self._runtime is not None:
+            self._runtime._bus.services.add(service)
+            if self._started:
+                self._call_soon(service._start)
+        return service
+
+    def create_client(self, srv_type: Any, name: str) -> Client:
+        """A client of ``name``: ``await client.wait_for_service()``, ``await client.call(request)``."""
+        client = Client(self, srv_type, self.resolve_topic_name(name, kind="service"))
+        self._clients.append(client)
+        if self._runtime is not None:
+            self._runtime._bus.services.add(client)
+        return client
+
+    def create_action_server(
+        self,
+        action_type: Any,
+        name: str,
+        execute: Callable[[Any], Any],
+        *,
+        goal_callback: Callable[[Any], Any] | None = None,
+        cancel_callback: Callable[[Any], Any] | None = None,
+        callback_group: CallbackGroup | None = None,
+    ) -> ActionServer:
+        """Serve action ``name``: ``execute(goal_handle) -> Result`` per accepted goal."""
+        return ActionServer(
+            self,
+            action_type,
+            name,
+            execute,
+            goal_callback=goal_callback,
+            cancel_callback=cancel_callback,
+            callback_group=callback_group,
+        )
+
+    def create_action_client(self, action_type: Any, name: str) -> ActionClient:
+        """A client of action ``name``: ``handle = await client.send_goal(goal)``."""
+        return ActionClient(self, action_type, name)
+
+    def destroy_service(self, service: Service) -> None:
+        if service in self._services:
+            self._services.remove(service)
+            if self._runtime is not None:
+                self._runtime._bus.services.remove(service)
+            self._call_soon(service._close)
+
+    def destroy_client(self, client: Client) -> None:
+        if client in self._clients:
+            self._clients.remove(client)
+            client.destroyed = True
+            if self._runtime is not None:
+                self._runtime._bus.services.remove(client)
+
     @property
     def publishers(self) -> tuple[Publisher[Any], ...]:
         return tuple(self._publishers)
@@ -406,6 +479,8 @@ class Node:
         for timer in self._timers:
             if not timer._cancelled:
                 timer._start()
+        for service in self._services:
+            service._start()
         self._create_task(self._run_hook(self.on_start, "on_start"), name=f"on_start {self._fqn}")
 
     async def _run_hook(self, hook: Callable[[], Any], what: str) -> None:
@@ -422,6 +497,8 @@ class Node:
         """Cancel every task of this node and wait for them (on the node's loop)."""
         for sub in list(self._subscriptions):
             self._close_subscription(sub)
+        for service in list(self._services):
+            service._close()
         current = asyncio.current_task()
         tasks = [t for t in self._tasks if t is not current]
         for task in tasks:
@@ -431,7 +508,38 @@ class Node:
         self._started = False
 
     def _idle(self) -> bool:
-        return all(sub.is_idle() for sub in self._subscriptions)
+        return all(sub.is_idle() for sub in self._subscriptions) and all(
+            service.is_idle() for service in self._services
+        )
+
+    async def _wait_with_timeout(self, aw: Awaitable[R], timeout_sec: float | None) -> R:
+        """Await ``aw``; ``TimeoutError`` after ``timeout_sec`` on the node clock (sim time too)."""
+        if timeout_sec is None:
+            return await aw
+        if isinstance(timeout_sec, bool) or not isinstance(timeout_sec, (int, float)) or timeout_sec < 0:
+            raise ValueError(f"timeout_sec: expected a number >= 0 or None, got {timeout_sec!r}")
+        clock = self._clock
+        if not clock.use_sim_time:
+            async with asyncio.timeout(timeout_sec):
+                return await aw
+        loop = asyncio.get_running_loop()
+        work = asyncio.ensure_future(aw)
+        deadline = clock.now_ns() + round(timeout_sec * 1e9)
+        try:
+            while True:
+                alarm: asyncio.Future[None] = loop.create_future()
+                clock.add_waiter(deadline, alarm)
+                await asyncio.wait((work, alarm), return_when=asyncio.FIRST_COMPLETED)
+                if work.done():
+                    alarm.cancel()
+                    return work.result()
+                if alarm.exception() if not alarm.cancelled() else None:  # sim time jumped back
+                    deadline = clock.now_ns() + round(timeout_sec * 1e9)
+                    continue
+                raise TimeoutError(f"timed out after {timeout_sec} s of sim time")
+        finally:
+            if not work.done():
+                work.cancel()
 
     async def _invoke(
         self,

@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 from ._bus import Bus
 from ._clock import Clock
-from ._graph import EndpointInfo, Graph, NodeInfo, TopicInfo
+from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._node import Node
 from ._priority import PriorityLoop
 from ._pubsub import Publisher, Tap
@@ -207,21 +207,16 @@ class Runtime:
             for sub in node._subscriptions:
                 self._bus.add_subscription(sub)
                 added.append(sub)
-            self._attach_extras(node)
         except BaseException:
             for endpoint in added:
                 self._bus.remove(endpoint)
             node._unbind()
             raise
+        for endpoint in [*node._services, *node._clients]:
+            self._bus.services.add(endpoint)
         self._nodes.append(node)
         node._call_soon(node._start)
         return node
-
-    def _attach_extras(self, node: Node) -> None:
-        """Register a node's other entities (services, actions) — a hook for subclasses of Node."""
-        attach = getattr(node, "_attach_entities", None)
-        if attach is not None:
-            attach()
 
     def remove_node(self, node: Node) -> None:
         """Stop ``node``: its endpoints leave the graph at once, its tasks end on its loop."""
@@ -233,9 +228,8 @@ class Runtime:
     def _detach(self, node: Node) -> None:
         for endpoint in [*node._publishers, *node._subscriptions]:
             self._bus.remove(endpoint)
-        detach = getattr(node, "_detach_entities", None)
-        if detach is not None:
-            detach()
+        for service in [*node._services, *node._clients]:
+            self._bus.services.remove(service)
         loop = node._loop
         if loop is not None and not loop.is_closed():
             if loop is self._loop:
@@ -430,8 +424,21 @@ class Runtime:
             subs = tuple(info(s, "subscription") for s in t.subscriptions)
             types = tuple(sorted({e.type for e in (*pubs, *subs)}))
             topics.append(TopicInfo(t.name, types, pubs, subs))
-        extra = getattr(self, "_graph_extras", None)
-        services, actions = extra() if extra is not None else ((), ())
+        services = tuple(
+            ServiceInfo(
+                name,
+                tuple(sorted({e.type_name for e in (*servers, *clients)})),
+                tuple(s.node_name for s in servers),
+                tuple(c.node_name for c in clients),
+            )
+            for name, servers, clients in self._bus.services.snapshot()
+        )
+        suffix = "/_action/send_goal"
+        actions = tuple(
+            ServiceInfo(s.name[: -len(suffix)], tuple(t.rsplit("_SendGoal", 1)[0] for t in s.types), s.servers, s.clients)
+            for s in services
+            if s.name.endswith(suffix)
+        )
         return Graph(nodes, tuple(topics), tuple(self._bus.incompatibilities()), services, actions)
 
 

@@ -1,0 +1,329 @@
+"""Services in one process: servers, clients, and the registry that connects them.
+
+A call hands the request object to the server's node loop (zero-copy, like
+topics), the handler runs under its callback group, and the response — or the
+reason the handler failed — comes back on the caller's loop. Every call has its
+own future, so concurrent calls are matched to their callers by construction; a
+caller that timed out has its future cancelled and a late reply is dropped.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import inspect
+import threading
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from ._clock import _call_on
+from ._errors import ServiceError
+
+if TYPE_CHECKING:
+    from ._groups import CallbackGroup
+    from ._node import Node
+
+__all__ = ["Client", "Service", "ServiceRegistry", "ServiceUnavailableError"]
+
+
+class ServiceUnavailableError(ServiceError):
+    """No server offers the service (``wait_for_service`` first)."""
+
+
+def _srv_name(srv_type: Any) -> str:
+    return getattr(srv_type, "__msgtype__", None) or getattr(srv_type, "__name__", repr(srv_type))
+
+
+def check_srv_type(srv_type: Any) -> None:
+    if not (isinstance(srv_type, type) and hasattr(srv_type, "Request") and hasattr(srv_type, "Response")):
+        raise TypeError(
+            f"expected a service type with .Request and .Response (e.g. aiorobot.msgs.std_srvs.Trigger), got {srv_type!r}"
+        )
+
+
+@dataclass
+class _Call:
+    request: Any
+    loop: asyncio.AbstractEventLoop
+    future: asyncio.Future[Any]
+
+
+class Service:
+    """Answers requests with ``handler(request) -> response``; created by ``Node.create_service``."""
+
+    kind = "service"
+
+    def __init__(self, node: Node, srv_type: Any, name: str, handler: Callable[[Any], Any], group: CallbackGroup) -> None:
+        check_srv_type(srv_type)
+        if not callable(handler):
+            raise TypeError(f"service handler must be callable, got {handler!r}")
+        self.node = node
+        self.srv_type = srv_type
+        self.srv_name = name
+        self.handler = handler
+        self.callback_group = group
+        self._queue: deque[_Call] = deque()
+        self._waiter: asyncio.Future[None] | None = None
+        self._task: asyncio.Task[None] | None = None
+        self._busy = 0
+        self.destroyed = False
+        self.handled = 0
+
+    @property
+    def type_name(self) -> str:
+        return _srv_name(self.srv_type)
+
+    @property
+    def node_name(self) -> str:
+        return self.node.get_fully_qualified_name()
+
+    def __repr__(self) -> str:
+        return f"<Service {self.srv_name} {self.type_name} of {self.node_name} queued={len(self._queue)}>"
+
+    def is_idle(self) -> bool:
+        return not self._queue and self._busy == 0
+
+    def _enqueue(self, call: _Call) -> None:
+        """Queue a call (on the server node's loop)."""
+        if self.destroyed:
+            _reply(call, exc=ServiceUnavailableError(f"service {self.srv_name} went away"))
+            return
+        self._queue.append(call)
+        waiter = self._waiter
+        if waiter is not None:
+            self._waiter = None
+            if not waiter.done():
+                waiter.set_result(None)
+
+    def _start(self) -> None:
+        if self._task is None:
+            self._task = self.node._create_task(self._dispatch(), name=f"service {self.srv_name}")
+
+    async def _dispatch(self) -> None:
+        loop = self.node._loop
+        assert loop is not None
+        while True:
+            if not self._queue:
+                self._waiter = loop.create_future()
+                await self._waiter
+                continue
+            call = self._queue.popleft()
+            if call.future.done():  # the caller gave up already
+                continue
+            self._busy += 1
+            if self.callback_group.exclusive:
+                try:
+                    await self._handle(call)
+                finally:
+                    self._busy -= 1
+            else:
+                task = self.node._create_task(self._handle(call), name=f"service {self.srv_name} call")
+                task.add_done_callback(self._done)
+
+    def _done(self, _task: asyncio.Task[None]) -> None:
+        self._busy -= 1
+
+    async def _handle(self, call: _Call) -> None:
+        try:
+            async with self.callback_group:
+                response = self.handler(call.request)
+                if inspect.isawaitable(response):
+                    response = await response
+        except asyncio.CancelledError:
+            _reply(call, exc=ServiceError(f"service {self.srv_name} was shut down while handling the call"))
+            raise
+        except Exception as err:
+            self.node.get_logger().error(f"handler of service {self.srv_name} raised", exc_info=True)
+            _reply(call, exc=ServiceError(f"service {self.srv_name} failed: {type(err).__name__}: {err}"))
+            return
+        self.handled += 1
+        if not isinstance(response, self.srv_type.Response):
+            _reply(
+                call,
+                exc=ServiceError(
+                    f"service {self.srv_name}: the handler returned {type(response).__name__}, "
+                    f"expected {_srv_name(self.srv_type.Response)}"
+                ),
+            )
+            return
+        _reply(call, result=response)
+
+    def _close(self) -> None:
+        self.destroyed = True
+        while self._queue:
+            _reply(self._queue.popleft(), exc=ServiceUnavailableError(f"service {self.srv_name} went away"))
+        if self._task is not None:
+            self._task.cancel()
+
+    def destroy(self) -> None:
+        self.node.destroy_service(self)
+
+
+def _reply(call: _Call, *, result: Any = None, exc: BaseException | None = None) -> None:
+    def deliver() -> None:
+        if call.future.done():
+            return  # timed out or cancelled: the late reply is dropped
+        if exc is not None:
+            call.future.set_exception(exc)
+        else:
+            call.future.set_result(result)
+
+    _call_on(call.loop, deliver)
+
+
+class Client:
+    """Calls a service; created by ``Node.create_client``."""
+
+    kind = "client"
+
+    def __init__(self, node: Node, srv_type: Any, name: str) -> None:
+        check_srv_type(srv_type)
+        self.node = node
+        self.srv_type = srv_type
+        self.srv_name = name
+        self.destroyed = False
+        self._pending: set[asyncio.Future[Any]] = set()
+
+    @property
+    def type_name(self) -> str:
+        return _srv_name(self.srv_type)
+
+    @property
+    def node_name(self) -> str:
+        return self.node.get_fully_qualified_name()
+
+    def __repr__(self) -> str:
+        return f"<Client {self.srv_name} {self.type_name} of {self.node_name} pending={len(self._pending)}>"
+
+    def _registry(self) -> ServiceRegistry:
+        return self.node.runtime._bus.services
+
+    def service_is_ready(self) -> bool:
+        return self.node._runtime is not None and bool(self._registry().servers(self.srv_name, self.type_name))
+
+    async def wait_for_service(self, timeout_sec: float | None = None) -> bool:
+        """True once a server offers the service; False after ``timeout_sec`` (node clock)."""
+        registry = self._registry()
+        fut = asyncio.get_running_loop().create_future()
+        registry.add_waiter(self.srv_name, self.type_name, fut)
+        try:
+            await self.node._wait_with_timeout(fut, timeout_sec)
+            return True
+        except TimeoutError:
+            return False
+        finally:
+            registry.remove_waiter(self.srv_name, fut)
+
+    async def call(self, request: Any, timeout_sec: float | None = None) -> Any:
+        """Send ``request`` and return the response.
+
+        Raises ``TimeoutError`` after ``timeout_sec`` (on the node clock),
+        :class:`ServiceError` with the server's reason when its handler fails, and
+        :class:`ServiceUnavailableError` at once when no server offers the service.
+        """
+        if self.destroyed:
+            raise RuntimeError(f"{self!r} was destroyed")
+        if not isinstance(request, self.srv_type.Request):
+            raise TypeError(
+                f"client of {self.srv_name} expects {_srv_name(self.srv_type.Request)}, got {type(request).__name__}"
+            )
+        servers = self._registry().servers(self.srv_name, self.type_name)
+        if not servers:
+            raise ServiceUnavailableError(
+                f"no server for service {self.srv_name} [{self.type_name}]; await client.wait_for_service() first"
+            )
+        loop = asyncio.get_running_loop()
+        fut: asyncio.Future[Any] = loop.create_future()
+        server = servers[0]
+        self._pending.add(fut)
+        try:
+            server.node._call_soon(server._enqueue, _Call(request, loop, fut))
+            try:
+                return await self.node._wait_with_timeout(fut, timeout_sec)
+            except TimeoutError:
+                raise TimeoutError(
+                    f"service {self.srv_name} did not answer within {timeout_sec} s"
+                ) from None
+        finally:
+            self._pending.discard(fut)
+            if not fut.done():
+                fut.cancel()
+
+    def destroy(self) -> None:
+        self.node.destroy_client(self)
+
+
+@dataclass
+class _Entry:
+    servers: list[Service] = field(default_factory=list)
+    clients: list[Client] = field(default_factory=list)
+    waiters: list[tuple[str, asyncio.Future[None]]] = field(default_factory=list)
+
+
+class ServiceRegistry:
+    """Which servers and clients exist for each service name (thread-safe)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._entries: dict[str, _Entry] = {}
+
+    def add(self, endpoint: Service | Client) -> None:
+        with self._lock:
+            entry = self._entries.setdefault(endpoint.srv_name, _Entry())
+            if isinstance(endpoint, Service):
+                entry.servers.append(endpoint)
+                ready = [fut for t, fut in entry.waiters if t == endpoint.type_name]
+                entry.waiters = [(t, f) for t, f in entry.waiters if t != endpoint.type_name]
+            else:
+                entry.clients.append(endpoint)
+                ready = []
+        for fut in ready:
+            _call_on(fut.get_loop(), _resolve, fut)
+
+    def remove(self, endpoint: Service | Client) -> None:
+        with self._lock:
+            entry = self._entries.get(endpoint.srv_name)
+            if entry is None:
+                return
+            for group in (entry.servers, entry.clients):
+                if endpoint in group:
+                    group.remove(endpoint)  # type: ignore[arg-type]
+            if not entry.servers and not entry.clients and not entry.waiters:
+                del self._entries[endpoint.srv_name]
+
+    def servers(self, name: str, type_name: str | None = None) -> list[Service]:
+        with self._lock:
+            entry = self._entries.get(name)
+            if entry is None:
+                return []
+            return [s for s in entry.servers if type_name is None or s.type_name == type_name]
+
+    def add_waiter(self, name: str, type_name: str, fut: asyncio.Future[None]) -> None:
+        with self._lock:
+            entry = self._entries.setdefault(name, _Entry())
+            if any(s.type_name == type_name for s in entry.servers):
+                fut.set_result(None)
+                return
+            entry.waiters.append((type_name, fut))
+
+    def remove_waiter(self, name: str, fut: asyncio.Future[None]) -> None:
+        with self._lock:
+            entry = self._entries.get(name)
+            if entry is not None:
+                entry.waiters = [(t, f) for t, f in entry.waiters if f is not fut]
+                if not entry.servers and not entry.clients and not entry.waiters:
+                    del self._entries[name]
+
+    def snapshot(self) -> list[tuple[str, list[Service], list[Client]]]:
+        with self._lock:
+            return [
+                (name, list(e.servers), list(e.clients))
+                for name, e in sorted(self._entries.items())
+                if e.servers or e.clients
+            ]
+
+
+def _resolve(fut: asyncio.Future[None]) -> None:
+    if not fut.done():
+        fut.set_result(None)
