@@ -81,7 +81,10 @@ class BaseController(Node):
         self.kinematics = self._make_kinematics()
         p = self.declare_parameter
         names = p(
-            "joint_names", list(self.kinematics.wheel_names), description="wheel joints, in kinematic order"
+            "joint_names",
+            list(self.kinematics.wheel_names),
+            description="wheel joints, in kinematic order",
+            read_only=True,
         ).value
         if len(names) != self.kinematics.n_wheels:
             raise ValueError(
@@ -104,10 +107,10 @@ class BaseController(Node):
         self.cmd_timeout_sec = p(
             "cmd_timeout_sec", 0.5, description="zero the wheels when /cmd_vel is older", range=(1e-3, 3600.0)
         ).value
-        self.rate_hz = p("rate_hz", 50.0, description="wheel command rate", range=(1.0, 1000.0)).value
-        self.odom_frame_id = p("odom_frame_id", "odom", description="odometry frame").value
-        self.base_frame_id = p("base_frame_id", "base_link", description="robot base frame").value
-        self.publish_tf = p("publish_tf", True, description="broadcast odom -> base_link").value
+        self.rate_hz = p("rate_hz", 50.0, description="wheel command rate", range=(1.0, 1000.0), read_only=True).value
+        self.odom_frame_id = p("odom_frame_id", "odom", description="odometry frame", read_only=True).value
+        self.base_frame_id = p("base_frame_id", "base_link", description="robot base frame", read_only=True).value
+        self.publish_tf = p("publish_tf", True, description="broadcast odom -> base_link", read_only=True).value
         self.odometry = WheelOdometry(self.kinematics)
         self.target = np.zeros(3)
         self.wheel_command: NDArray[np.float64] = np.zeros(self.kinematics.n_wheels)
@@ -129,6 +132,7 @@ class BaseController(Node):
         self.create_subscription(Twist, "/cmd_vel", self.on_cmd_vel, 10)
         self.create_subscription(JointState, "/joint_states", self.on_joint_states, 10)
         self.timer = self.create_timer(1.0 / self.rate_hz, self.on_tick)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
         if self.publish_tf:
             import aiorobot.tf as tf
 
@@ -139,6 +143,31 @@ class BaseController(Node):
     def _make_kinematics(self) -> Kinematics:
         raise NotImplementedError("subclasses build their kinematics")
 
+
+    _LIMITS = {
+        "max_linear_x": ("max_velocity", 0),
+        "max_linear_y": ("max_velocity", 1),
+        "max_angular_z": ("max_velocity", 2),
+        "max_accel_x": ("max_acceleration", 0),
+        "max_accel_y": ("max_acceleration", 1),
+        "max_accel_angular": ("max_acceleration", 2),
+    }
+
+    def _on_set_parameters(self, parameters: list[Any]) -> Any:
+        """Limits, ``max_wheel_speed`` and ``cmd_timeout_sec`` change live; the rest is read-only."""
+        from aiorobot import SetParametersResult
+
+        for parameter in parameters:
+            if parameter.name in self._LIMITS:
+                array_name, axis = self._LIMITS[parameter.name]
+                getattr(self.smoother, array_name)[axis] = float(parameter.value)
+                if array_name == "max_acceleration":
+                    self.smoother.max_deceleration[axis] = float(parameter.value)
+            elif parameter.name == "max_wheel_speed":
+                self.max_wheel_speed = float(parameter.value)
+            elif parameter.name == "cmd_timeout_sec":
+                self.cmd_timeout_sec = float(parameter.value)
+        return SetParametersResult(successful=True)
 
     # -- command path ------------------------------------------------------------------
 
@@ -267,8 +296,8 @@ class DiffDriveController(BaseController):
         super().__init__("diff_drive_controller", **kw)
 
     def _make_kinematics(self) -> Kinematics:
-        r = self.declare_parameter("wheel_radius", 0.05, description="wheel radius, m").value
-        s = self.declare_parameter("wheel_separation", 0.3, description="distance between the wheels, m").value
+        r = self.declare_parameter("wheel_radius", 0.05, description="wheel radius, m", read_only=True).value
+        s = self.declare_parameter("wheel_separation", 0.3, description="distance between the wheels, m", read_only=True).value
         return DiffDrive(r, s)
 
     def _target_from_twist(self, msg: Any) -> NDArray[np.float64]:
@@ -286,7 +315,7 @@ class MecanumController(BaseController):
         super().__init__("mecanum_controller", **kw)
 
     def _make_kinematics(self) -> Kinematics:
-        r = self.declare_parameter("wheel_radius", 0.05, description="wheel radius, m").value
-        a = self.declare_parameter("half_length", 0.15, description="half the wheelbase, m").value
-        b = self.declare_parameter("half_width", 0.15, description="half the track width, m").value
+        r = self.declare_parameter("wheel_radius", 0.05, description="wheel radius, m", read_only=True).value
+        a = self.declare_parameter("half_length", 0.15, description="half the wheelbase, m", read_only=True).value
+        b = self.declare_parameter("half_width", 0.15, description="half the track width, m", read_only=True).value
         return Mecanum(r, a, b)

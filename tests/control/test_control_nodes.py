@@ -197,3 +197,23 @@ async def test_odometry_is_broadcast_as_odom_to_base_link_on_tf():
         assert (t.header.frame_id, t.child_frame_id) == ("odom", "base_footprint")
         assert t.transform.translation.x == pytest.approx(0.5)
         assert t.header.stamp.sec == 2
+
+
+async def test_limits_change_live_and_geometry_is_read_only():
+    from aiorobot import Parameter
+
+    async with Runtime() as rt:
+        controller = DiffDriveController(
+            parameter_overrides={"max_linear_x": 0.3, "max_accel_x": 1000.0, "wheel_radius": 0.1}
+        )
+        probe = Probe()
+        rt.add_node(controller, executor="priority")
+        rt.add_node(probe)
+        probe.streaming = twist(vx=5.0)
+        await wait_until(lambda: probe.wheel_commands and probe.wheel_commands[-1][0] == pytest.approx(3.0))
+        [result] = controller.set_parameters([Parameter("max_linear_x", 0.5)])
+        assert result.successful
+        await wait_until(lambda: probe.wheel_commands[-1][0] == pytest.approx(5.0))
+        [result] = controller.set_parameters([Parameter("wheel_radius", 0.2)])
+        assert not result.successful and "read" in result.reason.lower()
+        assert controller.kinematics.wheel_radius == 0.1
