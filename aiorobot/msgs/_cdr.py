@@ -15,12 +15,15 @@ import struct
 from collections.abc import Callable
 from typing import Any
 
-from ._cdr_gen import Bad, build_deserializer, build_serializer, fmt_path, generated_source, where
 from ._classgen import Message
 from ._registry import get
 from ._spec import PRIMITIVES
 
 __all__ = ["DeserializationError", "SerializationError", "deserialize", "serialize"]
+
+
+class Bad(Exception):
+    """Raised inside generated codecs; turned into (De)SerializationError with context."""
 
 
 class DeserializationError(ValueError):
@@ -50,6 +53,8 @@ def serialize(msg: Any) -> bytes:
         if not isinstance(msg, Message):
             raise TypeError(f"serialize() expects an aiorobot.msgs message instance, got "
                             f"{cls.__name__} {msg!r:.80}")
+        from ._cdr_gen import build_serializer  # code generation is loaded on first use
+
         fn = _SER[cls] = build_serializer(cls)
     try:
         return fn(msg)
@@ -58,6 +63,8 @@ def serialize(msg: Any) -> bytes:
 
 
 def _ser_error(msg: Any, exc: BaseException) -> SerializationError:
+    from ._cdr_gen import fmt_path, where
+
     entries, local = where(exc.__traceback__)
     detail = str(exc)
     path = ""
@@ -132,6 +139,8 @@ def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str) -> A
     endian = "<" if data[1] == 1 else ">"
     fn = _DES.get((cls, endian))
     if fn is None:
+        from ._cdr_gen import build_deserializer
+
         fn = _DES[(cls, endian)] = build_deserializer(cls, endian)
     try:
         obj, end = fn(data, 4)
@@ -145,6 +154,8 @@ def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str) -> A
 
 
 def _des_error(cls: type, data: Any, exc: BaseException) -> DeserializationError:
+    from ._cdr_gen import fmt_path, where
+
     entries, local = where(exc.__traceback__)
     offset = local.get("p")
     if isinstance(exc, Bad):
@@ -166,6 +177,8 @@ def _des_error(cls: type, data: Any, exc: BaseException) -> DeserializationError
 
 def _debug_source(msg_type: type | str, kind: str = "ser") -> str:  # pragma: no cover - dev aid
     """The generated source of a codec (for debugging the generator)."""
+    from ._cdr_gen import build_deserializer, build_serializer, generated_source
+
     cls = msg_type if isinstance(msg_type, type) else get(msg_type)
     fn = build_serializer(cls) if kind == "ser" else build_deserializer(cls, "<")
     return generated_source(fn)

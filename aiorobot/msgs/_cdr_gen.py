@@ -14,18 +14,15 @@ from typing import Any
 
 import numpy as np
 
+from ._cdr import Bad
 from ._classgen import as_array, as_fixed_array, dtype_of
 from ._registry import get
 from ._spec import ARRAY, PRIMITIVES, SCALAR, SEQUENCE, FieldType, MsgSpec
 
-__all__ = ["build_deserializer", "build_serializer", "generated_source", "where"]
+__all__ = ["build_deserializer", "build_serializer", "fmt_path", "generated_source", "where"]
 
 HEADER_LE = b"\x00\x01\x00\x00"
 _PAD = tuple(b"\x00" * i for i in range(8))
-
-
-class Bad(Exception):
-    """Raised inside generated code; turned into (De)SerializationError with context."""
 
 
 def _min_size(t: FieldType) -> int:

@@ -11,9 +11,8 @@ from __future__ import annotations
 
 import difflib
 import threading
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from ._spec import Field, FieldType, MsgSpec, parse_action, parse_msg, parse_srv, parse_type
 
@@ -35,8 +34,7 @@ _INTERFACES_DIR = Path(__file__).with_name("_interfaces")
 _KINDS = {"msg": ".msg", "srv": ".srv", "action": ".action"}
 
 
-@dataclass(frozen=True, slots=True)
-class ServiceSpec:
+class ServiceSpec(NamedTuple):
     """A service ``pkg/srv/Name`` (or an action's ``pkg/action/Name_SendGoal``)."""
 
     name: str
@@ -45,8 +43,7 @@ class ServiceSpec:
     event: MsgSpec
 
 
-@dataclass(frozen=True, slots=True)
-class ActionSpec:
+class ActionSpec(NamedTuple):
     name: str
     goal: MsgSpec
     result: MsgSpec

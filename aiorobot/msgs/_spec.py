@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import keyword
 import re
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 __all__ = [
     "PRIMITIVES",
@@ -64,8 +63,7 @@ _FIELD_NAME_RE = re.compile(r"^[a-z][a-z0-9_]*$")
 _CONST_NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
-@dataclass(frozen=True, slots=True)
-class FieldType:
+class FieldType(NamedTuple):
     """The type of one field.
 
     ``base`` is a primitive name, ``string``, ``wstring`` or a message type
@@ -104,22 +102,19 @@ class FieldType:
         return base
 
 
-@dataclass(frozen=True, slots=True)
-class Field:
+class Field(NamedTuple):
     name: str
     type: FieldType
     default: Any = None  # None: the type's zero value
 
 
-@dataclass(frozen=True, slots=True)
-class Constant:
+class Constant(NamedTuple):
     name: str
     type: str
     value: Any
 
 
-@dataclass(frozen=True, slots=True)
-class MsgSpec:
+class MsgSpec(NamedTuple):
     """A message type: ``name`` like ``geometry_msgs/msg/Twist``."""
 
     name: str
