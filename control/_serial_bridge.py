@@ -52,6 +52,8 @@ class SerialMotorBridge(Node):
     - The port is reopened every ``reconnect_period_sec`` while it is missing. Bad frames are
       counted by kind (``statistics()``) and logged, throttled.
     - Reads and writes are non-blocking: the loop watches the port's descriptor.
+    - Link timeouts (heartbeat, reconnect) run on the monotonic wall clock, not on
+      ``/clock``: the hardware lives in real time even when the graph uses sim time.
     """
 
     def __init__(self, **kw: Any) -> None:

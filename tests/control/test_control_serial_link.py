@@ -100,3 +100,29 @@ def test_sending_on_a_closed_link_is_refused():
 
 async def _open(link):
     return link.open()
+
+
+async def test_writes_never_block_when_the_other_end_stops_reading():
+    import os
+    import tty
+
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    try:
+        link = SerialLink(os.ttyname(slave), 115200, on_message=lambda m: None)
+        assert link.open()
+        try:
+            # nobody reads the master side: the pty buffer fills; a blocking write would hang here
+            for i in range(20_000):
+                link.send(SetWheelVelocities((float(i),) * 4))
+            stats = link.statistics()
+            assert stats.packets_sent == 20_000
+            assert stats.bytes_dropped > 0 and stats.bytes_sent > 0
+            assert link.connected
+            # the loop stays responsive
+            await asyncio.sleep(0)
+        finally:
+            link.close()
+    finally:
+        os.close(master)
+        os.close(slave)
