@@ -131,15 +131,20 @@ def test_missing_command_module_is_one_line(
 
 
 def test_help_does_not_import_heavy_modules() -> None:
+    """``--help`` loads nothing heavy beyond what ``import aiorobot`` itself loads."""
     code = (
         "import sys, contextlib, io\n"
+        "heavy = {'numpy', 'numba', 'rosbags', 'cv2', 'rich', 'uvloop', 'filterpy', 'scipy'}\n"
+        "import aiorobot\n"
+        "before = {m.split('.')[0] for m in sys.modules}\n"
         "from aiorobot.cli import main\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         "    main(['--help']); main(['run', '--help'])\n"
-        "print(sorted({m.split('.')[0] for m in sys.modules} & {'numpy', 'numba', 'rosbags', 'cv2', 'rich'}))\n"
+        "after = {m.split('.')[0] for m in sys.modules}\n"
+        "print(sorted((after - before) & heavy), sorted(after & {'numba', 'rosbags', 'cv2'}))\n"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert result.stdout.strip() == "[]", result.stderr
+    assert result.stdout.strip() == "[] []", result.stderr
 
 
 def test_console_script_runs_the_cli() -> None:
