@@ -111,7 +111,9 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
                 try:
                     rt.add_node(node, executor=executor)
                 except QoSIncompatibleError as err:  # strict_qos: the graph as written cannot connect
-                    raise ConfigError(config.path, node_config.key, f"runtime.strict_qos is set and {err}") from None
+                    raise ConfigError(
+                        config.path, node_config.key, f"runtime.strict_qos is set and {err}"
+                    ) from None
             display = StatusDisplay(
                 [node for node, _ in nodes], period_sec=status_period_sec, on_stream_closed=rt.shutdown
             )
