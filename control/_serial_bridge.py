@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from aiorobot import Node
+from aiorobot import Node, Time
 
 from ._framing import FrameError
 from ._messages import (
@@ -29,6 +29,9 @@ from ._odometry import tick_delta
 from ._serial_link import SerialLink
 
 __all__ = ["SerialMotorBridge"]
+
+#: Largest gap tolerated between host time and a mapped firmware timestamp before re-anchoring.
+_MAX_CLOCK_SKEW_NS = 100_000_000
 
 _DEFAULT_JOINTS = [
     "front_left_wheel_joint",
@@ -93,6 +96,7 @@ class SerialMotorBridge(Node):
         self.feedback_published = 0
         self.commands_sent = 0
         self._shutting_down = False
+        self._clock_offset_ns: int | None = None
 
         from aiorobot.msgs.sensor_msgs import JointState
         from aiorobot.msgs.std_msgs import Bool
@@ -133,6 +137,7 @@ class SerialMotorBridge(Node):
         self._connected_at = now
         self._last_firmware_heartbeat = now  # grace period: one timeout from now
         self._last_ticks = None  # a new session: the firmware's counters start afresh
+        self._clock_offset_ns = None
         self.get_logger().info(f"connected to {self.port} at {self.baud_rate} baud")
         self.link.send(HostHeartbeat(self._host_time_ms()))
         self.link.send(VersionRequest())
@@ -228,12 +233,23 @@ class SerialMotorBridge(Node):
         self._last_ticks = ticks
         self._last_tick_us = message.timestamp_us
         msg = self._joint_state_type()
-        msg.header.stamp = self.now().to_msg()
+        msg.header.stamp = self._stamp_from_firmware(message.timestamp_us).to_msg()
         msg.name = list(self.joint_names)
         msg.position = self.wheel_positions_rad.copy()
         msg.velocity = self.wheel_velocities_rad_s.copy()
         self.joint_pub.publish(msg)
         self.feedback_published += 1
+
+    def _stamp_from_firmware(self, timestamp_us: int) -> Time:
+        """Host time of a firmware timestamp: firmware time plus an offset fixed at the first reading.
+
+        Stamps then keep the firmware's even spacing instead of the host's scheduling jitter. The
+        offset is re-anchored when the two clocks drift more than ``_MAX_CLOCK_SKEW_NS`` apart.
+        """
+        now_ns = self.now().nanoseconds
+        if self._clock_offset_ns is None or abs(timestamp_us * 1000 + self._clock_offset_ns - now_ns) > _MAX_CLOCK_SKEW_NS:
+            self._clock_offset_ns = now_ns - timestamp_us * 1000
+        return Time(nanoseconds=timestamp_us * 1000 + self._clock_offset_ns)
 
     # -- host -> firmware ----------------------------------------------------------------
 

@@ -234,3 +234,20 @@ async def test_simulated_firmware_node_receives_the_bridge_zero_command_at_shutd
         await wait_until(lambda: np.all(firmware_node.firmware.target_rad_s == 2.5))
     assert not np.any(firmware_node.firmware.target_rad_s)
     assert not (tmp_path / "ttyMOTORS").exists()
+
+
+async def test_joint_state_stamps_follow_the_firmware_clock(tmp_path):
+    path = str(tmp_path / "ttyMOTORS")
+    firmware = SimulatedFirmware(ticks_period_sec=0.02)
+    async with PtyFirmware(firmware, link_path=path):
+        async with Runtime() as rt:
+            bridge = bridge_for(path)
+            probe = Probe()
+            rt.add_node(bridge)
+            rt.add_node(probe)
+            await wait_until(lambda: len(probe.joint_states) > 20)
+            stamps = [s.header.stamp.sec * 10**9 + s.header.stamp.nanosec for s in probe.joint_states[-15:]]
+            spacing = np.diff(stamps)
+            # differences of firmware microsecond timestamps, not of host receive times (nanoseconds)
+            assert np.all(spacing % 1000 == 0) and np.all(spacing > 0)
+            assert abs(stamps[-1] - bridge.now().nanoseconds) < 200_000_000
