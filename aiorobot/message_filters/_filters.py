@@ -1,0 +1,228 @@
+"""Filter plumbing: callbacks, the subscription filter and the time-history cache."""
+
+from __future__ import annotations
+
+import bisect
+import inspect
+import logging
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from .._qos import QoSProfile
+from .._time import Time
+
+if TYPE_CHECKING:
+    from .._groups import CallbackGroup
+    from .._node import Node
+    from .._pubsub import Subscription
+
+__all__ = ["Cache", "Connection", "SimpleFilter", "Subscriber", "stamp_ns_of"]
+
+_log = logging.getLogger("aiorobot.message_filters")
+
+
+def stamp_ns_of(msg: Any) -> int | None:
+    """``msg.header.stamp`` in integer nanoseconds, or ``None`` for a message without a header stamp."""
+    header = getattr(msg, "header", None)
+    stamp = getattr(header, "stamp", None)
+    if stamp is None:
+        return None
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+class Connection:
+    """A registered callback; ``disconnect()`` unregisters it."""
+
+    def __init__(self, owner: SimpleFilter, callback: Callable[..., Any]) -> None:
+        self._owner = owner
+        self.callback = callback
+
+    def __repr__(self) -> str:
+        return f"<Connection {self.callback!r} of {self._owner!r}>"
+
+    @property
+    def connected(self) -> bool:
+        return self in self._owner._connections
+
+    def disconnect(self) -> None:
+        if self in self._owner._connections:
+            self._owner._connections.remove(self)
+
+
+class SimpleFilter:
+    """A filter with outputs: ``register_callback(cb)``; ``cb(*messages)`` may be ``async def`` or ``def``.
+
+    ``node`` is the node whose clock and logger the filter uses (``None`` when it has none).
+    """
+
+    def __init__(self, node: Node | None = None) -> None:
+        self.node = node
+        self._connections: list[Connection] = []
+
+    def register_callback(self, callback: Callable[..., Any]) -> Connection:
+        """Call ``callback(*messages)`` on every output of this filter, in registration order."""
+        if not callable(callback):
+            raise TypeError(f"register_callback expects a callable, got {callback!r}")
+        conn = Connection(self, callback)
+        self._connections.append(conn)
+        return conn
+
+    async def signal_message(self, *messages: Any) -> None:
+        """Call every registered callback with ``messages`` (awaiting ``async def`` ones)."""
+        for conn in list(self._connections):
+            result = conn.callback(*messages)
+            if inspect.isawaitable(result):
+                await result
+
+    def _logger_name(self) -> str:
+        return self.node.get_fully_qualified_name() if self.node is not None else "<no node>"
+
+
+class Subscriber(SimpleFilter):
+    """A node subscription as a filter input: every message it receives is passed on.
+
+    Parameters
+    ----------
+    node
+        The node that subscribes.
+    msg_type, topic, qos
+        As for ``Node.create_subscription``.
+    callback_group
+        The group the subscription's callback (and so the downstream filters' callbacks) runs in.
+    """
+
+    def __init__(
+        self,
+        node: Node,
+        msg_type: type[Any],
+        topic: str,
+        qos: QoSProfile | int = 10,
+        *,
+        callback_group: CallbackGroup | None = None,
+    ) -> None:
+        super().__init__(node)
+        self.msg_type = msg_type
+        self.subscription: Subscription[Any] = node.create_subscription(
+            msg_type, topic, self._on_message, qos, callback_group=callback_group
+        )
+
+    def __repr__(self) -> str:
+        return f"<Subscriber {self.topic_name} {self.subscription.type_name} of {self._logger_name()}>"
+
+    @property
+    def topic_name(self) -> str:
+        """The resolved topic name."""
+        return self.subscription.topic_name
+
+    async def _on_message(self, msg: Any) -> None:
+        await self.signal_message(msg)
+
+    def destroy(self) -> None:
+        """Destroy the underlying subscription."""
+        assert self.node is not None
+        self.node.destroy_subscription(self.subscription)
+
+
+class Cache(SimpleFilter):
+    """The last ``cache_size`` messages of an input, ordered by stamp, queryable by time.
+
+    Every message added is passed on to this filter's callbacks. With
+    ``allow_headerless=True`` a message without ``header.stamp`` is stamped with
+    the node's clock (or the system time) on arrival; otherwise it is dropped with
+    a warning.
+    """
+
+    def __init__(self, input_filter: SimpleFilter | None = None, cache_size: int = 1, *, allow_headerless: bool = False) -> None:
+        super().__init__(input_filter.node if input_filter is not None else None)
+        if isinstance(cache_size, bool) or not isinstance(cache_size, int) or cache_size < 1:
+            raise ValueError(f"cache_size: expected an int >= 1, got {cache_size!r}")
+        self.cache_size = cache_size
+        self.allow_headerless = allow_headerless
+        self._stamps: list[int] = []
+        self._msgs: list[Any] = []
+        self._warned_headerless = False
+        self.incoming: Connection | None = None
+        if input_filter is not None:
+            self.connect_input(input_filter)
+
+    def __repr__(self) -> str:
+        return f"<Cache {len(self._msgs)}/{self.cache_size} messages>"
+
+    def __len__(self) -> int:
+        return len(self._msgs)
+
+    def connect_input(self, input_filter: SimpleFilter) -> None:
+        if self.incoming is not None:
+            self.incoming.disconnect()
+        if self.node is None:
+            self.node = input_filter.node
+        self.incoming = input_filter.register_callback(self.add)
+
+    async def add(self, msg: Any) -> None:
+        """Insert ``msg`` by its stamp (dropping the oldest beyond ``cache_size``) and pass it on."""
+        if not self.add_nowait(msg):
+            return
+        await self.signal_message(msg)
+
+    def add_nowait(self, msg: Any) -> bool:
+        """Insert ``msg`` without calling the callbacks; ``False`` when it was dropped for lack of a stamp."""
+        stamp = stamp_ns_of(msg)
+        if stamp is None:
+            if not self.allow_headerless:
+                if not self._warned_headerless:
+                    _log.warning(
+                        "Cache of %s: %s has no header.stamp; dropped. Pass allow_headerless=True to stamp "
+                        "such messages on arrival",
+                        self._logger_name(),
+                        type(msg).__name__,
+                    )
+                    self._warned_headerless = True
+                return False
+            stamp = _now_ns(self)
+        i = bisect.bisect_right(self._stamps, stamp)
+        self._stamps.insert(i, stamp)
+        self._msgs.insert(i, msg)
+        if len(self._msgs) > self.cache_size:
+            del self._stamps[0]
+            del self._msgs[0]
+        return True
+
+    def get_interval(self, start: Time, end: Time) -> list[Any]:
+        """Messages stamped in ``[start, end]``, oldest first."""
+        lo = bisect.bisect_left(self._stamps, start.nanoseconds)
+        hi = bisect.bisect_right(self._stamps, end.nanoseconds)
+        return self._msgs[lo:hi]
+
+    def get_surrounding_interval(self, start: Time, end: Time) -> list[Any]:
+        """As :meth:`get_interval`, plus the newest message before ``start`` and the oldest after ``end``."""
+        lo = max(bisect.bisect_right(self._stamps, start.nanoseconds) - 1, 0)
+        hi = min(bisect.bisect_left(self._stamps, end.nanoseconds) + 1, len(self._msgs))
+        return self._msgs[lo:hi]
+
+    def get_elem_after_time(self, time: Time) -> Any | None:
+        """The oldest message stamped at or after ``time``."""
+        i = bisect.bisect_left(self._stamps, time.nanoseconds)
+        return self._msgs[i] if i < len(self._msgs) else None
+
+    def get_elem_before_time(self, time: Time) -> Any | None:
+        """The newest message stamped at or before ``time``."""
+        i = bisect.bisect_right(self._stamps, time.nanoseconds)
+        return self._msgs[i - 1] if i > 0 else None
+
+    def get_latest_time(self) -> Time | None:
+        return Time(nanoseconds=self._stamps[-1]) if self._stamps else None
+
+    def get_oldest_time(self) -> Time | None:
+        return Time(nanoseconds=self._stamps[0]) if self._stamps else None
+
+    def get_last(self) -> Any | None:
+        """The newest message, or ``None`` when empty."""
+        return self._msgs[-1] if self._msgs else None
+
+
+def _now_ns(f: SimpleFilter) -> int:
+    if f.node is not None:
+        return f.node.now().nanoseconds
+    import time
+
+    return time.time_ns()
