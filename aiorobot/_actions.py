@@ -19,9 +19,7 @@ from collections import deque
 from collections.abc import AsyncIterator, Callable
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from ._groups import CallbackGroup, ReentrantCallbackGroup
+from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ._qos import DurabilityPolicy, QoSProfile
 from ._services import ServiceUnavailableError
 
@@ -87,7 +85,7 @@ def _check_action_type(action_type: Any) -> None:
 
 
 def _gid(goal_id: Any) -> bytes:
-    return bytes(np.asarray(goal_id.uuid, dtype=np.uint8))
+    return bytes(bytearray(goal_id.uuid))
 
 
 def _gid_str(goal_id: Any) -> str:
@@ -408,6 +406,7 @@ class ClientGoalHandle:
     async def _fetch_result(self) -> Any:
         action = self._client.action_type
         response = await self._client._get_result.call(action.GetResult.Request(goal_id=self.goal_id))
+        self._client._drain_feedback()
         self._result = response.result
         self._set_status(GoalStatus(response.status))
         self._client._handles.pop(_gid(self.goal_id), None)
@@ -438,12 +437,15 @@ class ActionClient:
         self._send_goal = node.create_client(action_type.SendGoal, base + "send_goal")
         self._cancel_goal = node.create_client(CancelGoal, base + "cancel_goal")
         self._get_result = node.create_client(action_type.GetResult, base + "get_result")
-        group = ReentrantCallbackGroup()
+        # Inline dispatch in one private group keeps feedback and status in publish order
+        # (with _drain_feedback); user feedback callbacks still run as tasks of their own.
+        group = MutuallyExclusiveCallbackGroup()
         self._handles: dict[bytes, ClientGoalHandle] = {}
+        self._feedback_sub = node.create_subscription(
+            action_type.FeedbackMessage, base + "feedback", self._on_feedback, FEEDBACK_QOS, callback_group=group
+        )
         self._subs = [
-            node.create_subscription(
-                action_type.FeedbackMessage, base + "feedback", self._on_feedback, FEEDBACK_QOS, callback_group=group
-            ),
+            self._feedback_sub,
             node.create_subscription(GoalStatusArray, base + "status", self._on_status, STATUS_QOS, callback_group=group),
         ]
 
@@ -455,7 +457,14 @@ class ActionClient:
         if handle is not None:
             handle._on_feedback(msg)
 
+    def _drain_feedback(self) -> None:
+        """Handle feedback still queued: it was published before the status or result now arriving."""
+        queue = self._feedback_sub._queue
+        while queue:
+            self._on_feedback(queue.popleft())
+
     def _on_status(self, msg: Any) -> None:
+        self._drain_feedback()
         for st in msg.status_list:
             handle = self._handles.get(_gid(st.goal_info.goal_id))
             if handle is not None and not handle.status.is_terminal:
@@ -489,7 +498,7 @@ class ActionClient:
             raise TypeError(f"send_goal expects {action.Goal.__msgtype__}, got {type(goal).__name__}")
         if not self._send_goal.service_is_ready():
             raise ServiceUnavailableError(f"no action server for {self.name}; await wait_for_server() first")
-        goal_id = UUID(uuid=np.frombuffer(uuid.uuid4().bytes, dtype=np.uint8).copy())
+        goal_id = UUID(uuid=uuid.uuid4().bytes)
         handle = ClientGoalHandle(self, goal_id, feedback_callback)
         gid = _gid(goal_id)
         self._handles[gid] = handle  # before sending: feedback may arrive before the reply

@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import asyncio
-import concurrent.futures
 import logging
-import multiprocessing
 import os
 import signal
 import sys
 import threading
 from collections.abc import Coroutine
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from ._bus import Bus
 from ._clock import Clock
@@ -23,6 +21,9 @@ from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
 from ._transport import Transport, make_transport
 from ._waker import LoopWaker, TimerFdWaker, make_waker
+
+if TYPE_CHECKING:
+    import concurrent.futures
 
 __all__ = ["Runtime", "run"]
 
@@ -389,6 +390,9 @@ class Runtime:
         if self._state != "running":
             raise RuntimeError(f"offload needs a running runtime ({self!r})")
         if self._processes is None:
+            import concurrent.futures
+            import multiprocessing
+
             method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
             self._processes = concurrent.futures.ProcessPoolExecutor(
                 max_workers=self._process_workers or os.cpu_count() or 2,
@@ -400,6 +404,8 @@ class Runtime:
         if self._state != "running":
             raise RuntimeError(f"run_in_thread needs a running runtime ({self!r})")
         if self._threads is None:
+            import concurrent.futures
+
             self._threads = concurrent.futures.ThreadPoolExecutor(
                 max_workers=self._thread_workers or min(32, (os.cpu_count() or 2) + 4),
                 thread_name_prefix="aiorobot-worker",
