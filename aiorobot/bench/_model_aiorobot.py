@@ -1,0 +1,64 @@
+"""Executor model ``aiorobot``: the seed experiment written as a user writes it.
+
+The control node runs on the priority loop; the perception node stays on the
+main loop and sends its 150 ms of work to the runtime's process pool with
+``Node.offload``. Nothing here reaches into the runtime's internals.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from ._seedconfig import SeedConfig
+from ._workload import work_function
+
+__all__ = ["run_aiorobot"]
+
+
+def _nodes(kind: str, cfg: SeedConfig, done: Callable[[], None]) -> tuple[object, object]:
+    from aiorobot import Node
+
+    class Control(Node):
+        """A 50 Hz control loop: records when each tick starts."""
+
+        def __init__(self) -> None:
+            super().__init__("control")
+            self.stamps: list[float] = []
+            self.create_timer(cfg.control_period_sec, self.tick)
+
+        async def tick(self) -> None:
+            self.stamps.append(time.perf_counter())
+            if len(self.stamps) == cfg.stamps_needed:
+                done()
+
+    class Perception(Node):
+        """150 ms of work every 100 ms, in the process pool."""
+
+        def __init__(self) -> None:
+            super().__init__("perception")
+            self.work = work_function(kind)
+            self.create_timer(cfg.perception_period_sec, self.perceive)
+
+        async def perceive(self) -> None:
+            await self.offload(self.work, cfg.work_sec)
+
+    return Control(), Perception()
+
+
+async def _main(kind: str, cfg: SeedConfig) -> list[float]:
+    from aiorobot import Runtime
+
+    async with Runtime(handle_signals=False) as rt:
+        control, perception = _nodes(kind, cfg, rt.shutdown)
+        rt.add_node(control, executor="priority")
+        rt.add_node(perception)
+        await rt.spin()
+    return list(control.stamps)  # type: ignore[attr-defined]
+
+
+def run_aiorobot(kind: str, cfg: SeedConfig) -> list[float]:
+    """Run the model; returns the control callback's start stamps in seconds."""
+    import aiorobot
+
+    return aiorobot.run(_main(kind, cfg))

@@ -1,0 +1,145 @@
+"""Machine noise beside the figures: CPU steal and load from /proc.
+
+These machines are shared virtual machines: the host steals CPU in bursts and a
+stall of 10 ms to 1 s can hit any process. A maximum means nothing without the
+steal figure of the same interval, so every part of the benchmark runs inside a
+:class:`NoiseMeter` and reports what it saw.
+
+The parsing functions are pure (they take the text of the /proc files), the
+meter reads the files. Where /proc does not exist (macOS, Windows) the figures
+are ``None``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass
+from typing import Any
+
+__all__ = ["CpuTimes", "NoiseMeter", "NoiseSample", "noise_between", "parse_loadavg", "parse_proc_stat"]
+
+_FIELDS = ("user", "nice", "system", "idle", "iowait", "irq", "softirq", "steal")
+
+
+@dataclass(frozen=True, slots=True)
+class CpuTimes:
+    """The machine-wide ``cpu`` line of /proc/stat, in clock ticks."""
+
+    user: int
+    nice: int
+    system: int
+    idle: int
+    iowait: int
+    irq: int
+    softirq: int
+    steal: int
+
+    @property
+    def total(self) -> int:
+        # guest and guest_nice are already counted inside user and nice.
+        return self.user + self.nice + self.system + self.idle + self.iowait + self.irq + self.softirq + self.steal
+
+    @property
+    def busy(self) -> int:
+        return self.user + self.nice + self.system + self.irq + self.softirq
+
+
+def parse_proc_stat(text: str) -> CpuTimes:
+    """Read the aggregate ``cpu`` line of /proc/stat.
+
+    Raises ``ValueError`` naming what was expected when the line is missing.
+    """
+    for line in text.splitlines():
+        parts = line.split()
+        if parts and parts[0] == "cpu":
+            values = [int(v) for v in parts[1:9]]
+            values += [0] * (len(_FIELDS) - len(values))  # very old kernels lack steal
+            return CpuTimes(*values)
+    raise ValueError("expected a line starting with 'cpu ' in /proc/stat, received none")
+
+
+def parse_loadavg(text: str) -> float:
+    """The one-minute load average from the text of /proc/loadavg."""
+    try:
+        return float(text.split()[0])
+    except (IndexError, ValueError):
+        raise ValueError(f"expected /proc/loadavg to start with a number, received {text[:40]!r}") from None
+
+
+@dataclass(frozen=True, slots=True)
+class NoiseSample:
+    """What the machine did during one interval.
+
+    ``steal_pct``: share of all CPU time stolen by the host; ``busy_pct``: share
+    spent in user and system code by every process (this benchmark included);
+    ``load1``: the one-minute load average at the end. ``None`` where /proc is
+    not available.
+    """
+
+    wall_sec: float
+    steal_pct: float | None
+    busy_pct: float | None
+    load1: float | None
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def noise_between(before: CpuTimes, after: CpuTimes, wall_sec: float, load1: float | None) -> NoiseSample:
+    """The noise figures of the interval between two /proc/stat readings."""
+    total = after.total - before.total
+    if total <= 0:
+        return NoiseSample(wall_sec=wall_sec, steal_pct=0.0, busy_pct=0.0, load1=load1)
+    return NoiseSample(
+        wall_sec=wall_sec,
+        steal_pct=100.0 * (after.steal - before.steal) / total,
+        busy_pct=100.0 * (after.busy - before.busy) / total,
+        load1=load1,
+    )
+
+
+def _read(path: str) -> str | None:
+    try:
+        with open(path, encoding="ascii") as f:
+            return f.read()
+    except OSError:
+        return None
+
+
+class NoiseMeter:
+    """Context manager measuring steal and load over the block it wraps.
+
+    >>> with NoiseMeter() as meter:
+    ...     pass
+    >>> meter.result.wall_sec >= 0.0
+    True
+    """
+
+    def __init__(self) -> None:
+        self._before: CpuTimes | None = None
+        self._t0 = 0.0
+        self.result: NoiseSample | None = None
+
+    def __enter__(self) -> NoiseMeter:
+        import time
+
+        text = _read("/proc/stat")
+        self._before = parse_proc_stat(text) if text is not None else None
+        self._t0 = time.monotonic()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        import time
+
+        wall = time.monotonic() - self._t0
+        text = _read("/proc/stat")
+        load_text = _read("/proc/loadavg")
+        load1 = parse_loadavg(load_text) if load_text is not None else None
+        if text is None or self._before is None:
+            self.result = NoiseSample(wall_sec=wall, steal_pct=None, busy_pct=None, load1=load1)
+        else:
+            self.result = noise_between(self._before, parse_proc_stat(text), wall, load1)
+
+
+def cpu_count() -> int:
+    return os.cpu_count() or 1

@@ -1,0 +1,174 @@
+"""The benchmark's tables (rich), one per part, with reference rows and noise beside the figures."""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["print_report", "render_report"]
+
+
+def _f(value: Any, digits: int = 1) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, int):
+        return f"{value:,}"
+    if isinstance(value, float):
+        return f"{value:,.{digits}f}"
+    return str(value)
+
+
+def _noise(noise: dict[str, Any] | None) -> tuple[str, str]:
+    if not noise:
+        return "-", "-"
+    return _f(noise.get("steal_pct"), 1), _f(noise.get("load1"), 2)
+
+
+def _seed_table(part: dict[str, Any]) -> Any:
+    from rich.table import Table
+
+    cfg = part.get("config", {})
+    title = (
+        f"Seed experiment: {1e3 * cfg.get('control_period_sec', 0.02):g} ms control period, "
+        f"{1e3 * cfg.get('work_sec', 0.15):g} ms perception every {1e3 * cfg.get('perception_period_sec', 0.1):g} ms, "
+        f"{cfg.get('periods', '?')} periods after {cfg.get('warmup', '?')} warm-up (ms)"
+    )
+    table = Table(title=title, title_justify="left")
+    for col in ("model", "work", "samples", "mean", "stdev", "p50", "p99", "max", ">1 ms", ">5 ms", "steal %", "load"):
+        table.add_column(col, justify="left" if col in ("model", "work") else "right")
+    for model, kinds in part.get("models", {}).items():
+        for kind, res in kinds.items():
+            if "error" in res:
+                table.add_row(model, kind, res["error"], *[""] * 9)
+                continue
+            s = res["stats"]
+            table.add_row(
+                model,
+                kind,
+                _f(s["samples"]),
+                _f(s["mean_ms"]),
+                _f(s["stdev_ms"]),
+                _f(s["p50_ms"]),
+                _f(s["p99_ms"]),
+                _f(s["max_ms"]),
+                _f(s["late_1ms"]),
+                _f(s["late_5ms"]),
+                *_noise(res.get("noise")),
+            )
+    for name, ref in part.get("reference", {}).items():
+        table.add_row(
+            f"[dim]{name}[/dim]", "[dim]sleep[/dim]", "-", _f(ref.get("mean_ms")), _f(ref.get("stdev_ms")),
+            "-", "-", _f(ref.get("max_ms")), "-", "-", "-", "-",
+        )
+    table.caption = (
+        "single: one asyncio loop, perception inline | threads: rclpy MultiThreadedExecutor(4) model, "
+        "one group each | aiorobot: control on the priority loop, perception via Node.offload. "
+        "sleep releases the GIL, cpu holds it. Dim rows: the seed's published rclpy figures."
+    )
+    return table
+
+
+def _timer_table(part: dict[str, Any]) -> Any:
+    from rich.table import Table
+
+    table = Table(
+        title=f"Priority loop: {part.get('period_ms', 1.0):g} ms timer for {part.get('duration_sec', '?')} s (us)",
+        title_justify="left",
+    )
+    for col in ("main loop", "error p50", "error p99", "error max", "late p50", "late p99", "late max",
+                "overruns", "CPU % core", "steal %", "load"):
+        table.add_column(col, justify="left" if col == "main loop" else "right")
+    for row in part.get("rows", []):
+        e, late = row["period_error"], row["lateness_us"]
+        table.add_row(
+            row["main_loop"], _f(e["p50_us"]), _f(e["p99_us"]), _f(e["max_us"]),
+            _f(late["p50_us"]), _f(late["p99_us"]), _f(late["max_us"]),
+            _f(row["overruns"]), _f(row["thread_cpu_pct"], 2), *_noise(row.get("noise")),
+        )
+    table.add_row("[dim]target[/dim]", "", "[dim]<= 100[/dim]", "[dim]<= 500[/dim]", "", "", "", "", "[dim]< 10[/dim]", "", "")
+    table.caption = "error: |period - nominal|; late: start after deadline (Timer.stats); CPU: the priority thread's CPU time over wall time"
+    return table
+
+
+def _latency_table(part: dict[str, Any]) -> Any:
+    from rich.table import Table
+
+    table = Table(title="Publish -> callback latency (us) and throughput", title_justify="left")
+    for col in ("path", "payload", "p50", "p99", "max", "msgs/s", "steal %", "load"):
+        table.add_column(col, justify="left" if col in ("path", "payload") else "right")
+    for row in part.get("rows", []):
+        if "note" in row:
+            table.add_row(row["path"], row["payload"], f"[dim]{row['note']}[/dim]", "", "", "", "", "")
+            continue
+        lat = row["latency"]
+        table.add_row(
+            row["path"], row["payload"], _f(lat["p50_us"]), _f(lat["p99_us"]), _f(lat["max_us"]),
+            _f(round(row["msgs_per_sec"])), *_noise(row.get("noise")),
+        )
+    table.caption = "process pool: the round trip of await node.offload(echo, msg); targets: same loop p50 <= 10 us and >= 200k msgs/s, main -> priority p99 <= 100 us"
+    return table
+
+
+def _cpu_table(part: dict[str, Any]) -> Any:
+    from rich.table import Table
+
+    table = Table(title="CPU cost: process CPU time / wall time", title_justify="left")
+    for col in ("case", "% of a core", "steal %", "load"):
+        table.add_column(col, justify="left" if col == "case" else "right")
+    for row in part.get("rows", []):
+        table.add_row(row["case"], _f(row["core_pct"], 2), *_noise(row.get("noise")))
+    for name, pct in part.get("reference", {}).items():
+        table.add_row(f"[dim]{name}[/dim]", f"[dim]{_f(pct)}[/dim]", "-", "-")
+    table.caption = "target: a 100 Hz publishing timer <= 2 % of a core"
+    return table
+
+
+def _tf_table(part: dict[str, Any]) -> Any:
+    from rich.table import Table
+
+    table = Table(title="tf", title_justify="left")
+    table.add_column("figure")
+    table.add_column("value", justify="right")
+    for key, value in part.items():
+        if isinstance(value, dict):
+            continue
+        table.add_row(key, _f(value, 2))
+    return table
+
+
+_TABLES = {"seed": _seed_table, "timer": _timer_table, "latency": _latency_table, "cpu": _cpu_table, "tf": _tf_table}
+
+
+def render_report(doc: dict[str, Any]) -> list[Any]:
+    """The renderables of a benchmark document: a header line, then one table per part."""
+    from rich.text import Text
+
+    meta = doc.get("meta", {})
+    noise = meta.get("noise") or {}
+    header = Text(
+        f"aiorobot bench latency - {meta.get('date_utc', '?')} - {meta.get('cpus', '?')} CPUs, "
+        f"Python {meta.get('python', '?')}, {meta.get('platform', '?')} - repeat {meta.get('repeat', 1)}"
+        f"{' (median)' if meta.get('repeat', 1) > 1 else ''}{' - QUICK' if meta.get('quick') else ''} - "
+        f"steal {_f(noise.get('steal_pct'))} %, load {_f(noise.get('load1'), 2)}"
+    )
+    out: list[Any] = [header]
+    for name, part in doc.get("parts", {}).items():
+        if "error" in part:
+            out.append(Text(f"{name}: {part['error']}"))
+            continue
+        out.append(_TABLES[name](part))
+    return out
+
+
+def print_report(doc: dict[str, Any], console: Any = None) -> None:
+    """Print the report to ``console`` (a rich Console; stdout by default)."""
+    from rich.console import Console
+
+    if console is None:
+        console = Console()
+        if not console.is_terminal:  # a file or a pipe: do not squeeze the tables into 80 columns
+            console = Console(width=160)
+    for item in render_report(doc):
+        console.print(item)
+        console.print()
