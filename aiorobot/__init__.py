@@ -16,6 +16,7 @@ from ._actions import (
     ServerGoalHandle,
 )
 from ._clock import Clock
+from ._config import ConfigError, GraphConfig, load_config
 from ._errors import (
     InvalidNameError,
     InvalidParameterValueError,
@@ -62,12 +63,14 @@ __all__ = [
     "ServerGoalHandle",
     "CallbackGroup",
     "Client",
+    "ConfigError",
     "Clock",
     "ClockType",
     "DurabilityPolicy",
     "Duration",
     "EndpointInfo",
     "Graph",
+    "GraphConfig",
     "HistoryPolicy",
     "InvalidNameError",
     "InvalidParameterValueError",
@@ -101,6 +104,7 @@ __all__ = [
     "TimerStatistics",
     "TopicInfo",
     "Transport",
+    "load_config",
     "qos_profile_sensor_data",
     "qos_profile_system_default",
     "run",
