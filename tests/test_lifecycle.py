@@ -314,3 +314,15 @@ async def test_without_communication_interface_there_are_no_services(runtime):
     node = runtime.add_node(Recorder(enable_communication_interface=False))
     assert node.lifecycle_services == []
     assert [p.topic_name for p in node.publishers] == ["/out"]
+
+
+async def test_hooks_of_a_priority_loop_node_run_on_its_loop(runtime):
+    import threading
+
+    class OnPriority(LifecycleNode):
+        async def on_configure(self, state):
+            self.hook_thread = threading.get_ident()
+
+    node = runtime.add_node(OnPriority("prio"), executor="priority")
+    assert await node.trigger_configure() is S.INACTIVE
+    assert node.hook_thread == node._thread_id != threading.get_ident()

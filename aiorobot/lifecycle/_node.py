@@ -160,7 +160,20 @@ class LifecycleNode(Node):
     async def change_state(
         self, transition: int | str | LifecycleTransition
     ) -> tuple[LifecycleState, TransitionCallbackReturn]:
-        """As :meth:`trigger_transition`, also returning the hook's result (what ``~/change_state`` reports)."""
+        """As :meth:`trigger_transition`, also returning the hook's result (what ``~/change_state`` reports).
+
+        The hooks run on the node's loop: called from another loop (a node on the
+        priority loop driven from the main loop), the transition is handed over.
+        """
+        loop = self._loop
+        if loop is not None and loop is not asyncio.get_running_loop():
+            future = asyncio.run_coroutine_threadsafe(self._change_state(transition), loop)
+            return await asyncio.wrap_future(future)
+        return await self._change_state(transition)
+
+    async def _change_state(
+        self, transition: int | str | LifecycleTransition
+    ) -> tuple[LifecycleState, TransitionCallbackReturn]:
         start = self._machine.state
         edge = self._machine.begin(transition)
         self._after_step(edge)
