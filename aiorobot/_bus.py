@@ -35,6 +35,8 @@ class Incompatibility:
     publisher: str
     subscription: str
     reason: str
+    publisher_node: str = ""
+    subscription_node: str = ""
 
 
 @dataclass
@@ -156,6 +158,27 @@ class Bus:
             else:
                 sub.node._call_soon(sub._enqueue, msg)
 
+    def preview(self, publishers: list[Publisher], subscriptions: list[Sub]) -> list[tuple[Publisher, Sub, str]]:
+        """The pairs that would not connect if these endpoints joined, without registering them.
+
+        Lets a runtime refuse a whole set of nodes under ``strict_qos`` before any starts.
+        """
+        with self._lock:
+            pubs: dict[str, list[Publisher]] = {n: list(t.publishers) for n, t in self._topics.items()}
+            subs: dict[str, list[Sub]] = {n: list(t.subscriptions) for n, t in self._topics.items()}
+        new = {id(e) for e in (*publishers, *subscriptions)}
+        for p in publishers:
+            pubs.setdefault(p.topic_name, []).append(p)
+        for s in subscriptions:
+            subs.setdefault(s.topic_name, []).append(s)
+        return [
+            (p, s, reason)
+            for topic, topic_pubs in pubs.items()
+            for p in topic_pubs
+            for s in subs.get(topic, [])
+            if (id(p) in new or id(s) in new) and (reason := self._why_not(p, s))
+        ]
+
     # -- introspection --------------------------------------------------------------
 
     def snapshot(self) -> list[_Topic]:
@@ -169,7 +192,7 @@ class Bus:
     def incompatibilities(self) -> list[Incompatibility]:
         with self._lock:
             return [
-                Incompatibility(t.name, p.describe(), s.describe(), r)
+                Incompatibility(t.name, p.describe(), s.describe(), r, p.node_name, s.node_name)
                 for t in self._topics.values()
                 for p, s, r in t.incompatible
             ]

@@ -11,7 +11,8 @@ import threading
 from collections.abc import Coroutine
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ._bus import Bus
+from ._bus import Bus, Incompatibility
+from ._errors import QoSIncompatibleError
 from ._clock import Clock
 from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._node import Node
@@ -158,8 +159,7 @@ class Runtime:
             self._bus.add_subscription(self._clock_tap)
         self._state = "running"
         try:
-            for node, executor in [*self._pending, *built]:
-                self.add_node(node, executor=executor)
+            self.add_nodes([*self._pending, *built])
         except BaseException:
             await self._close()
             raise
@@ -218,6 +218,32 @@ class Runtime:
         self._nodes.append(node)
         node._call_soon(node._start)
         return node
+
+    def check_qos(self, nodes: list[Node]) -> list[Incompatibility]:
+        """What would not connect if ``nodes`` joined this runtime (nothing is added).
+
+        ``add_nodes`` uses it under ``strict_qos`` so that a graph that cannot connect
+        is refused whole, before any of its nodes starts.
+        """
+        pubs = [p for n in nodes for p in n._publishers]
+        subs = [s for n in nodes for s in n._subscriptions]
+        return [
+            Incompatibility(p.topic_name, p.describe(), s.describe(), reason, p.node_name, s.node_name)
+            for p, s, reason in self._bus.preview(pubs, subs)
+        ]
+
+    def add_nodes(self, nodes: list[tuple[Node, str]]) -> None:
+        """Add several ``(node, executor)`` pairs; under ``strict_qos`` all or none."""
+        if self.strict_qos:
+            problems = self.check_qos([node for node, _ in nodes])
+            if problems:
+                bad = problems[0]
+                raise QoSIncompatibleError(
+                    f"incompatible QoS on {bad.topic}: {bad.publisher} does not connect to "
+                    f"{bad.subscription} ({bad.reason})"
+                )
+        for node, executor in nodes:
+            self.add_node(node, executor=executor)
 
     def remove_node(self, node: Node) -> None:
         """Stop ``node``: its endpoints leave the graph at once, its tasks end on its loop."""

@@ -87,7 +87,7 @@ def main(args: argparse.Namespace) -> int:
 
 
 async def _serve(config: GraphConfig, duration_sec: float | None, status_period_sec: float) -> int:
-    from aiorobot import QoSIncompatibleError, Runtime
+    from aiorobot import Runtime
     from aiorobot._config import ConfigError
     from aiorobot._config_build import build_nodes
 
@@ -107,13 +107,17 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
         ) as rt:
             for signum in signals:
                 loop.add_signal_handler(signum, _on_signal, rt, signum)
-            for node_config, (node, executor) in zip(config.nodes, nodes, strict=True):
-                try:
-                    rt.add_node(node, executor=executor)
-                except QoSIncompatibleError as err:  # strict_qos: the graph as written cannot connect
+            if runtime_config.strict_qos:  # the graph as written cannot connect: refuse it whole
+                for problem in rt.check_qos([node for node, _ in nodes]):
+                    owners = {problem.publisher_node, problem.subscription_node}
+                    index = max(i for i, (n, _) in enumerate(nodes) if n.get_fully_qualified_name() in owners)
                     raise ConfigError(
-                        config.path, node_config.key, f"runtime.strict_qos is set and {err}"
-                    ) from None
+                        config.path,
+                        config.nodes[index].key,
+                        f"runtime.strict_qos is set and incompatible QoS on {problem.topic}: "
+                        f"{problem.publisher} does not connect to {problem.subscription} ({problem.reason})",
+                    )
+            rt.add_nodes(nodes)
             display = StatusDisplay(
                 [node for node, _ in nodes], period_sec=status_period_sec, on_stream_closed=rt.shutdown
             )

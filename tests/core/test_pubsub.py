@@ -236,3 +236,22 @@ async def test_duplicate_node_names_are_rejected(runtime):
     runtime.add_node(Node("n"))
     with pytest.raises(ValueError, match="already in this runtime"):
         runtime.add_node(Node("n"))
+
+
+async def test_add_nodes_under_strict_qos_is_all_or_nothing():
+    class Talker(Node):
+        def __init__(self):
+            super().__init__("talker")
+            self.create_publisher(Int32, "/x", QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT))
+
+    class Listener(Node):
+        def __init__(self):
+            super().__init__("listener")
+            self.create_subscription(Int32, "/x", print, 10)
+
+    async with Runtime(strict_qos=True, handle_signals=False) as rt:
+        [problem] = rt.check_qos([Talker(), Listener()])
+        assert (problem.publisher_node, problem.subscription_node) == ("/talker", "/listener")
+        with pytest.raises(QoSIncompatibleError, match="reliability"):
+            rt.add_nodes([(Talker(), "main"), (Listener(), "priority")])
+        assert rt.graph.nodes == () and rt.priority_loop is None
