@@ -182,3 +182,19 @@ async def test_synchronizer_rejects_non_filter_inputs(runtime):
         TimeSynchronizer([Subscriber(node, PointStamped, "/b"), "/a"], 10)
     with pytest.raises(ValueError, match=r"^slop_sec: expected a number of seconds >= 0, got -0\.1$"):
         ApproximateTimeSynchronizer([Subscriber(node, PointStamped, "/c"), Subscriber(node, PointStamped, "/d")], 5, -0.1)
+
+
+async def test_inputs_on_the_main_and_priority_loops_synchronize(runtime):
+    pubs = runtime.add_node(Node("pubs"))
+    main_node = runtime.add_node(Node("main_listener"))
+    prio_node = runtime.add_node(Node("prio_listener"), executor="priority")
+    pa = pubs.create_publisher(PointStamped, "/a", 10)
+    pb = pubs.create_publisher(PointStamped, "/b", 10)
+    sync = TimeSynchronizer([Subscriber(main_node, PointStamped, "/a"), Subscriber(prio_node, PointStamped, "/b")], 10)
+    got = []
+    sync.register_callback(lambda a, b: got.append((a.point.x, b.point.x)))
+    for t in (1.0, 2.0, 3.0):
+        pa.publish(point(t, x=t))
+        pb.publish(point(t, x=-t))
+        await settle(runtime)
+    assert got == [(1.0, -1.0), (2.0, -2.0), (3.0, -3.0)]
