@@ -11,7 +11,7 @@ from __future__ import annotations
 import enum
 import inspect
 import math
-from collections.abc import Awaitable, Callable, Iterable, Mapping, Sequence
+from collections.abc import Awaitable, Callable, Generator, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -260,20 +260,14 @@ class ParameterStore:
             entry.descriptor = _replace_type(entry.descriptor, ParameterType.of(value))
         entry.value = value
 
-    def set(self, params: Iterable[Parameter]) -> list[SetParametersResult]:
-        """Set each parameter on its own (not atomically), as ``rclpy.Node.set_parameters``."""
+    def _set_steps(self, params: Iterable[Parameter]) -> Generator[Any, SetParametersResult, list[SetParametersResult]]:
+        """Set each parameter on its own; yields each callback's verdict and is sent it back resolved."""
         results = []
         for param in params:
             result, value = self._vet(param)
             if result.successful:
                 for cb in self._callbacks:
-                    verdict = cb([Parameter(param.name, value)])
-                    if inspect.isawaitable(verdict):
-                        _close(verdict)
-                        raise TypeError(
-                            "an async on-set-parameters callback is registered: "
-                            "use `await node.set_parameters_async(...)`"
-                        )
+                    verdict = yield cb([Parameter(param.name, value)])
                     if not verdict.successful:
                         result = SetParametersResult(False, verdict.reason or "rejected by a callback")
                         break
@@ -282,23 +276,32 @@ class ParameterStore:
             results.append(result)
         return results
 
+    def set(self, params: Iterable[Parameter]) -> list[SetParametersResult]:
+        """Set each parameter on its own (not atomically), as ``rclpy.Node.set_parameters``."""
+        steps = self._set_steps(params)
+        try:
+            verdict = next(steps)
+            while True:
+                if inspect.isawaitable(verdict):
+                    _close(verdict)
+                    steps.close()
+                    raise TypeError(
+                        "an async on-set-parameters callback is registered: "
+                        "use `await node.set_parameters_async(...)`"
+                    )
+                verdict = steps.send(verdict)
+        except StopIteration as done:
+            return done.value
+
     async def set_async(self, params: Iterable[Parameter]) -> list[SetParametersResult]:
         """Like :meth:`set`, awaiting async callbacks."""
-        results = []
-        for param in params:
-            result, value = self._vet(param)
-            if result.successful:
-                for cb in self._callbacks:
-                    verdict = cb([Parameter(param.name, value)])
-                    if inspect.isawaitable(verdict):
-                        verdict = await verdict
-                    if not verdict.successful:
-                        result = SetParametersResult(False, verdict.reason or "rejected by a callback")
-                        break
-            if result.successful:
-                self._commit(param.name, value)
-            results.append(result)
-        return results
+        steps = self._set_steps(params)
+        try:
+            verdict = next(steps)
+            while True:
+                verdict = steps.send(await verdict if inspect.isawaitable(verdict) else verdict)
+        except StopIteration as done:
+            return done.value
 
 
 def _close(awaitable: Any) -> None:

@@ -49,7 +49,23 @@ class _Call:
     future: asyncio.Future[Any]
 
 
-class Service:
+class _ServiceEndpoint:
+    """What servers and clients share: a node, a service type and a name."""
+
+    node: Node
+    srv_type: Any
+    srv_name: str
+
+    @property
+    def type_name(self) -> str:
+        return _srv_name(self.srv_type)
+
+    @property
+    def node_name(self) -> str:
+        return self.node.get_fully_qualified_name()
+
+
+class Service(_ServiceEndpoint):
     """Answers requests with ``handler(request) -> response``; created by ``Node.create_service``."""
 
     kind = "service"
@@ -69,14 +85,6 @@ class Service:
         self._busy = 0
         self.destroyed = False
         self.handled = 0
-
-    @property
-    def type_name(self) -> str:
-        return _srv_name(self.srv_type)
-
-    @property
-    def node_name(self) -> str:
-        return self.node.get_fully_qualified_name()
 
     def __repr__(self) -> str:
         return f"<Service {self.srv_name} {self.type_name} of {self.node_name} queued={len(self._queue)}>"
@@ -172,7 +180,7 @@ def _reply(call: _Call, *, result: Any = None, exc: BaseException | None = None)
     _call_on(call.loop, deliver)
 
 
-class Client:
+class Client(_ServiceEndpoint):
     """Calls a service; created by ``Node.create_client``."""
 
     kind = "client"
@@ -184,14 +192,6 @@ class Client:
         self.srv_name = name
         self.destroyed = False
         self._pending: set[asyncio.Future[Any]] = set()
-
-    @property
-    def type_name(self) -> str:
-        return _srv_name(self.srv_type)
-
-    @property
-    def node_name(self) -> str:
-        return self.node.get_fully_qualified_name()
 
     def __repr__(self) -> str:
         return f"<Client {self.srv_name} {self.type_name} of {self.node_name} pending={len(self._pending)}>"
