@@ -1,74 +1,93 @@
 """aiorobot: an async-first asyncio robotics framework.
 
-Nodes, topics, QoS, timers, callback groups, parameters and ROS 2 messages,
-asyncio-native, with a priority loop for control. See API.md for the contract.
+Nodes, topics, QoS, timers, callback groups, parameters, services, actions and
+ROS 2 messages, asyncio-native, with a priority loop for control. See API.md
+for the contract.
+
+Public names are imported on first use (PEP 562), so ``import aiorobot.msgs``
+or ``aiorobot --help`` pay only for what they touch.
 """
 
 from __future__ import annotations
 
-from ._actions import (
-    ActionClient,
-    ActionServer,
-    CancelResponse,
-    ClientGoalHandle,
-    GoalResponse,
-    GoalStatus,
-    ServerGoalHandle,
-)
-from ._clock import Clock
-from ._config import ConfigError, GraphConfig, load_config
-from ._errors import (
-    InvalidNameError,
-    InvalidParameterValueError,
-    ParameterAlreadyDeclaredError,
-    ParameterError,
-    ParameterNotDeclaredError,
-    QoSIncompatibleError,
-    ServiceError,
-)
-from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
-from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
-from ._logging import NodeLogger, setup_logging
-from ._node import Node
-from ._parameters import (
-    Parameter,
-    ParameterDescriptor,
-    ParameterType,
-    SetParametersResult,
-)
-from ._pubsub import MessageStream, Publisher, Subscription
-from ._qos import (
-    DurabilityPolicy,
-    HistoryPolicy,
-    QoSProfile,
-    ReliabilityPolicy,
-    qos_profile_sensor_data,
-    qos_profile_system_default,
-)
-from ._runtime import Runtime, run
-from ._services import Client, Service, ServiceUnavailableError
-from ._time import ClockType, Duration, Time
-from ._timer import Rate, Timer, TimerStatistics
-from ._transport import LocalTransport, Transport
+import importlib
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
+
+_EXPORTS = {
+    "ActionClient": "_actions",
+    "ActionServer": "_actions",
+    "CallbackGroup": "_groups",
+    "CancelResponse": "_actions",
+    "Client": "_services",
+    "ClientGoalHandle": "_actions",
+    "Clock": "_clock",
+    "ClockType": "_time",
+    "ConfigError": "_config",
+    "DurabilityPolicy": "_qos",
+    "Duration": "_time",
+    "EndpointInfo": "_graph",
+    "GoalResponse": "_actions",
+    "GoalStatus": "_actions",
+    "Graph": "_graph",
+    "GraphConfig": "_config",
+    "HistoryPolicy": "_qos",
+    "InvalidNameError": "_errors",
+    "InvalidParameterValueError": "_errors",
+    "LocalTransport": "_transport",
+    "MessageStream": "_pubsub",
+    "MutuallyExclusiveCallbackGroup": "_groups",
+    "Node": "_node",
+    "NodeInfo": "_graph",
+    "NodeLogger": "_logging",
+    "Parameter": "_parameters",
+    "ParameterAlreadyDeclaredError": "_errors",
+    "ParameterDescriptor": "_parameters",
+    "ParameterError": "_errors",
+    "ParameterNotDeclaredError": "_errors",
+    "ParameterType": "_parameters",
+    "Publisher": "_pubsub",
+    "QoSIncompatibleError": "_errors",
+    "QoSProfile": "_qos",
+    "Rate": "_timer",
+    "ReentrantCallbackGroup": "_groups",
+    "ReliabilityPolicy": "_qos",
+    "Runtime": "_runtime",
+    "ServerGoalHandle": "_actions",
+    "Service": "_services",
+    "ServiceError": "_errors",
+    "ServiceInfo": "_graph",
+    "ServiceUnavailableError": "_services",
+    "SetParametersResult": "_parameters",
+    "Subscription": "_pubsub",
+    "Time": "_time",
+    "Timer": "_timer",
+    "TimerStatistics": "_timer",
+    "TopicInfo": "_graph",
+    "Transport": "_transport",
+    "load_config": "_config",
+    "qos_profile_sensor_data": "_qos",
+    "qos_profile_system_default": "_qos",
+    "run": "_runtime",
+    "setup_logging": "_logging",
+}
 
 __all__ = [
     "ActionClient",
     "ActionServer",
-    "CancelResponse",
-    "ClientGoalHandle",
-    "GoalResponse",
-    "GoalStatus",
-    "ServerGoalHandle",
     "CallbackGroup",
+    "CancelResponse",
     "Client",
-    "ConfigError",
+    "ClientGoalHandle",
     "Clock",
     "ClockType",
+    "ConfigError",
     "DurabilityPolicy",
     "Duration",
     "EndpointInfo",
+    "GoalResponse",
+    "GoalStatus",
     "Graph",
     "GraphConfig",
     "HistoryPolicy",
@@ -93,6 +112,7 @@ __all__ = [
     "ReentrantCallbackGroup",
     "ReliabilityPolicy",
     "Runtime",
+    "ServerGoalHandle",
     "Service",
     "ServiceError",
     "ServiceInfo",
@@ -110,3 +130,41 @@ __all__ = [
     "run",
     "setup_logging",
 ]
+
+if TYPE_CHECKING:
+    from ._actions import ActionClient, ActionServer, CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
+    from ._clock import Clock
+    from ._config import ConfigError, GraphConfig, load_config
+    from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
+    from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
+    from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+    from ._logging import NodeLogger, setup_logging
+    from ._node import Node
+    from ._parameters import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
+    from ._pubsub import MessageStream, Publisher, Subscription
+    from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default
+    from ._runtime import Runtime, run
+    from ._services import Client, Service, ServiceUnavailableError
+    from ._time import ClockType, Duration, Time
+    from ._timer import Rate, Timer, TimerStatistics
+    from ._transport import LocalTransport, Transport
+
+
+_SUBPACKAGES = frozenset(
+    {"control", "fusion", "lifecycle", "message_filters", "msgs", "perception", "testing", "tf"}
+)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _SUBPACKAGES:
+        return importlib.import_module(f"aiorobot.{name}")
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'aiorobot' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"aiorobot.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

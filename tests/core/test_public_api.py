@@ -30,3 +30,17 @@ def test_api_md_names_import_from_aiorobot():
         "ServiceError", "run",
     ]:
         assert hasattr(aiorobot, name), name
+
+
+def test_import_aiorobot_is_light_and_names_load_on_use():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, aiorobot\n"
+        "heavy = [m for m in ('numpy', 'numba', 'cv2', 'scipy', 'rosbags', 'asyncio') if m in sys.modules]\n"
+        "assert heavy == [], heavy\n"
+        "from aiorobot import Node\n"
+        "assert aiorobot.msgs.get('geometry_msgs/msg/Twist').__msgtype__ == 'geometry_msgs/msg/Twist'\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
