@@ -1,8 +1,11 @@
-"""Executor model ``aiorobot``: the seed experiment written as a user writes it.
+"""Executor models ``aiorobot`` and ``aiorobot-rt``: the seed experiment as a user writes it.
 
 The control node runs on the priority loop; the perception node stays on the
 main loop and sends its 150 ms of work to the runtime's process pool with
-``Node.offload``. Nothing here reaches into the runtime's internals.
+``Node.offload``. ``aiorobot`` uses ``Runtime()`` as it comes; ``aiorobot-rt``
+asks for ``Runtime(priority_realtime=True)`` (the priority thread under
+SCHED_FIFO where the OS permits it). Nothing here reaches into the runtime's
+internals beyond reading which scheduling tweaks were applied.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ from collections.abc import Callable
 from ._seedconfig import SeedConfig
 from ._workload import work_function
 
-__all__ = ["run_aiorobot"]
+__all__ = ["run_aiorobot", "run_aiorobot_rt"]
 
 
 def _nodes(kind: str, cfg: SeedConfig, done: Callable[[], None]) -> tuple[object, object]:
@@ -46,19 +49,30 @@ def _nodes(kind: str, cfg: SeedConfig, done: Callable[[], None]) -> tuple[object
     return Control(), Perception()
 
 
-async def _main(kind: str, cfg: SeedConfig) -> list[float]:
+async def _main(kind: str, cfg: SeedConfig, realtime: bool, applied: list[str]) -> list[float]:
     from aiorobot import Runtime
 
-    async with Runtime(handle_signals=False) as rt:
+    async with Runtime(handle_signals=False, priority_realtime=realtime) as rt:
         control, perception = _nodes(kind, cfg, rt.shutdown)
         rt.add_node(control, executor="priority")
         rt.add_node(perception)
+        if rt.priority_loop is not None:
+            applied.extend(rt.priority_loop.applied)
         await rt.spin()
     return list(control.stamps)  # type: ignore[attr-defined]
 
 
-def run_aiorobot(kind: str, cfg: SeedConfig) -> list[float]:
-    """Run the model; returns the control callback's start stamps in seconds."""
+def run_aiorobot(kind: str, cfg: SeedConfig, *, realtime: bool = False, applied: list[str] | None = None) -> list[float]:
+    """Run the model; returns the control callback's start stamps in seconds.
+
+    ``applied`` (if given) receives the priority thread's scheduling tweaks
+    (``"timerslack=1ns"``, ``"SCHED_FIFO"``).
+    """
     import aiorobot
 
-    return aiorobot.run(_main(kind, cfg))
+    return aiorobot.run(_main(kind, cfg, realtime, applied if applied is not None else []))
+
+
+def run_aiorobot_rt(kind: str, cfg: SeedConfig, *, applied: list[str] | None = None) -> list[float]:
+    """The ``aiorobot-rt`` model: the same nodes on ``Runtime(priority_realtime=True)``."""
+    return run_aiorobot(kind, cfg, realtime=True, applied=applied)

@@ -71,31 +71,55 @@ class NoiseSample:
     """What the machine did during one interval.
 
     ``steal_pct``: share of all CPU time stolen by the host; ``busy_pct``: share
-    spent in user and system code by every process (this benchmark included);
-    ``load1``: the one-minute load average at the end. ``None`` where /proc is
-    not available.
+    spent in user and system code by every process; ``others_pct``: the part of
+    ``busy_pct`` not spent by this process (nor its reaped children), i.e. what
+    other programs took from the machine; ``load1``: the one-minute load
+    average at the end. Shares are of the whole machine (all CPUs). ``None``
+    where /proc is not available.
     """
 
     wall_sec: float
     steal_pct: float | None
     busy_pct: float | None
     load1: float | None
+    others_pct: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
-def noise_between(before: CpuTimes, after: CpuTimes, wall_sec: float, load1: float | None) -> NoiseSample:
-    """The noise figures of the interval between two /proc/stat readings."""
+def noise_between(
+    before: CpuTimes, after: CpuTimes, wall_sec: float, load1: float | None, own_ticks: float | None = None
+) -> NoiseSample:
+    """The noise figures of the interval between two /proc/stat readings.
+
+    ``own_ticks``: CPU time this process used in the interval, in clock ticks;
+    with it, ``others_pct`` is the busy share this process did not account for.
+    """
     total = after.total - before.total
     if total <= 0:
-        return NoiseSample(wall_sec=wall_sec, steal_pct=0.0, busy_pct=0.0, load1=load1)
+        return NoiseSample(wall_sec=wall_sec, steal_pct=0.0, busy_pct=0.0, load1=load1, others_pct=0.0)
+    busy = 100.0 * (after.busy - before.busy) / total
+    others = None if own_ticks is None else max(0.0, busy - 100.0 * own_ticks / total)
     return NoiseSample(
         wall_sec=wall_sec,
         steal_pct=100.0 * (after.steal - before.steal) / total,
-        busy_pct=100.0 * (after.busy - before.busy) / total,
+        busy_pct=busy,
         load1=load1,
+        others_pct=others,
     )
+
+
+def _own_cpu_sec() -> float:
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def _clock_ticks_per_sec() -> float:
+    try:
+        return float(os.sysconf("SC_CLK_TCK"))
+    except (AttributeError, ValueError, OSError):  # pragma: no cover - non-POSIX
+        return 100.0
 
 
 def _read(path: str) -> str | None:
@@ -118,6 +142,7 @@ class NoiseMeter:
     def __init__(self) -> None:
         self._before: CpuTimes | None = None
         self._t0 = 0.0
+        self._own0 = 0.0
         self.result: NoiseSample | None = None
 
     def __enter__(self) -> NoiseMeter:
@@ -126,6 +151,7 @@ class NoiseMeter:
         text = _read("/proc/stat")
         self._before = parse_proc_stat(text) if text is not None else None
         self._t0 = time.monotonic()
+        self._own0 = _own_cpu_sec()
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -138,7 +164,8 @@ class NoiseMeter:
         if text is None or self._before is None:
             self.result = NoiseSample(wall_sec=wall, steal_pct=None, busy_pct=None, load1=load1)
         else:
-            self.result = noise_between(self._before, parse_proc_stat(text), wall, load1)
+            own_ticks = (_own_cpu_sec() - self._own0) * _clock_ticks_per_sec()
+            self.result = noise_between(self._before, parse_proc_stat(text), wall, load1, own_ticks)
 
 
 def cpu_count() -> int:

@@ -19,10 +19,14 @@ def _f(value: Any, digits: int = 1) -> str:
     return str(value)
 
 
-def _noise(noise: dict[str, Any] | None) -> tuple[str, str]:
+#: The noise columns printed beside every row's figures.
+NOISE_COLUMNS = ("steal %", "others %", "load")
+
+
+def _noise(noise: dict[str, Any] | None) -> tuple[str, str, str]:
     if not noise:
-        return "-", "-"
-    return _f(noise.get("steal_pct"), 1), _f(noise.get("load1"), 2)
+        return "-", "-", "-"
+    return _f(noise.get("steal_pct"), 1), _f(noise.get("others_pct"), 0), _f(noise.get("load1"), 2)
 
 
 def _seed_table(part: dict[str, Any]) -> Any:
@@ -35,12 +39,12 @@ def _seed_table(part: dict[str, Any]) -> Any:
         f"{cfg.get('periods', '?')} periods after {cfg.get('warmup', '?')} warm-up (ms)"
     )
     table = Table(title=title, title_justify="left")
-    for col in ("model", "work", "samples", "mean", "stdev", "p50", "p99", "max", ">1 ms", ">5 ms", "steal %", "load"):
+    for col in ("model", "work", "samples", "mean", "stdev", "p50", "p99", "max", ">1 ms", ">5 ms", *NOISE_COLUMNS):
         table.add_column(col, justify="left" if col in ("model", "work") else "right")
     for model, kinds in part.get("models", {}).items():
         for kind, res in kinds.items():
             if "error" in res:
-                table.add_row(model, kind, res["error"], *[""] * 9)
+                table.add_row(model, kind, res["error"], *[""] * 10)
                 continue
             s = res["stats"]
             table.add_row(
@@ -59,11 +63,12 @@ def _seed_table(part: dict[str, Any]) -> Any:
     for name, ref in part.get("reference", {}).items():
         table.add_row(
             f"[dim]{name}[/dim]", "[dim]sleep[/dim]", "-", _f(ref.get("mean_ms")), _f(ref.get("stdev_ms")),
-            "-", "-", _f(ref.get("max_ms")), "-", "-", "-", "-",
+            "-", "-", _f(ref.get("max_ms")), "-", "-", "-", "-", "-",
         )
     table.caption = (
         "single: one asyncio loop, perception inline | threads: rclpy MultiThreadedExecutor(4) model, "
-        "one group each | aiorobot: control on the priority loop, perception via Node.offload. "
+        "one group each | aiorobot: control on the priority loop, perception via Node.offload; aiorobot-rt: the same with "
+        "Runtime(priority_realtime=True) (SCHED_FIFO). "
         "sleep releases the GIL, cpu holds it. Dim rows: the seed's published rclpy figures."
     )
     return table
@@ -76,18 +81,21 @@ def _timer_table(part: dict[str, Any]) -> Any:
         title=f"Priority loop: {part.get('period_ms', 1.0):g} ms timer for {part.get('duration_sec', '?')} s (us)",
         title_justify="left",
     )
-    for col in ("main loop", "error p50", "error p99", "error max", "late p50", "late p99", "late max",
-                "overruns", "CPU % core", "steal %", "load"):
-        table.add_column(col, justify="left" if col == "main loop" else "right")
+    for col in ("priority thread", "main loop", "error p50", "error p99", "error max", "late p50", "late p99", "late max",
+                "overruns", "CPU % core", *NOISE_COLUMNS):
+        table.add_column(col, justify="left" if col in ("main loop", "priority thread") else "right")
     for row in part.get("rows", []):
         e, late = row["period_error"], row["lateness_us"]
         table.add_row(
-            row["main_loop"], _f(e["p50_us"]), _f(e["p99_us"]), _f(e["max_us"]),
+            row.get("scheduling", "-"), row["main_loop"], _f(e["p50_us"]), _f(e["p99_us"]), _f(e["max_us"]),
             _f(late["p50_us"]), _f(late["p99_us"]), _f(late["max_us"]),
             _f(row["overruns"]), _f(row["thread_cpu_pct"], 2), *_noise(row.get("noise")),
         )
-    table.add_row("[dim]target[/dim]", "", "[dim]<= 100[/dim]", "[dim]<= 500[/dim]", "", "", "", "", "[dim]< 10[/dim]", "", "")
-    table.caption = "error: |period - nominal|; late: start after deadline (Timer.stats); CPU: the priority thread's CPU time over wall time"
+    table.add_row("[dim]target[/dim]", "", "", "[dim]<= 100[/dim]", "[dim]<= 500[/dim]", "", "", "", "", "[dim]< 10[/dim]", "", "", "")
+    table.caption = (
+        "priority thread: Runtime() gives timerslack=1ns; Runtime(priority_realtime=True) adds SCHED_FIFO where permitted. "
+        "error: |period - nominal|; late: start after deadline (Timer.stats); CPU: the priority thread's CPU time over wall time"
+    )
     return table
 
 
@@ -95,18 +103,25 @@ def _latency_table(part: dict[str, Any]) -> Any:
     from rich.table import Table
 
     table = Table(title="Publish -> callback latency (us) and throughput", title_justify="left")
-    for col in ("path", "payload", "p50", "p99", "max", "msgs/s", "steal %", "load"):
+    for col in ("path", "payload", "p50", "p99", "max", "msgs/s", *NOISE_COLUMNS):
         table.add_column(col, justify="left" if col in ("path", "payload") else "right")
     for row in part.get("rows", []):
         if "note" in row:
-            table.add_row(row["path"], row["payload"], f"[dim]{row['note']}[/dim]", "", "", "", "", "")
+            table.add_row(row["path"], row["payload"], "[dim]n/a[/dim]", "", "", "", "", "", "")
             continue
         lat = row["latency"]
         table.add_row(
             row["path"], row["payload"], _f(lat["p50_us"]), _f(lat["p99_us"]), _f(lat["max_us"]),
             _f(round(row["msgs_per_sec"])), *_noise(row.get("noise")),
         )
-    table.caption = "process pool: the round trip of await node.offload(echo, msg); targets: same loop p50 <= 10 us and >= 200k msgs/s, main -> priority p99 <= 100 us"
+    notes = sorted({f"{r['path']}: {r['note']}" for r in part.get("rows", []) if "note" in r})
+    table.caption = "; ".join(
+        [
+            *notes,
+            "process pool: the round trip of await node.offload(echo, msg)",
+            "targets: same loop p50 <= 10 us and >= 200k msgs/s, main -> priority p99 <= 100 us",
+        ]
+    )
     return table
 
 
@@ -114,12 +129,12 @@ def _cpu_table(part: dict[str, Any]) -> Any:
     from rich.table import Table
 
     table = Table(title="CPU cost: process CPU time / wall time", title_justify="left")
-    for col in ("case", "% of a core", "steal %", "load"):
+    for col in ("case", "% of a core", *NOISE_COLUMNS):
         table.add_column(col, justify="left" if col == "case" else "right")
     for row in part.get("rows", []):
         table.add_row(row["case"], _f(row["core_pct"], 2), *_noise(row.get("noise")))
     for name, pct in part.get("reference", {}).items():
-        table.add_row(f"[dim]{name}[/dim]", f"[dim]{_f(pct)}[/dim]", "-", "-")
+        table.add_row(f"[dim]{name}[/dim]", f"[dim]{_f(pct)}[/dim]", "-", "-", "-")
     table.caption = "target: a 100 Hz publishing timer <= 2 % of a core"
     return table
 
@@ -127,7 +142,7 @@ def _cpu_table(part: dict[str, Any]) -> Any:
 def _tf_table(part: dict[str, Any]) -> Any:
     from rich.table import Table
 
-    table = Table(title="tf", title_justify="left")
+    table = Table(title="tf: lookups and batch point transforms", title_justify="left")
     table.add_column("figure")
     table.add_column("value", justify="right")
     for key, value in part.items():
@@ -150,9 +165,15 @@ def render_report(doc: dict[str, Any]) -> list[Any]:
         f"aiorobot bench latency - {meta.get('date_utc', '?')} - {meta.get('cpus', '?')} CPUs, "
         f"Python {meta.get('python', '?')}, {meta.get('platform', '?')} - repeat {meta.get('repeat', 1)}"
         f"{' (median)' if meta.get('repeat', 1) > 1 else ''}{' - QUICK' if meta.get('quick') else ''} - "
-        f"steal {_f(noise.get('steal_pct'))} %, load {_f(noise.get('load1'), 2)}"
+        f"steal {_f(noise.get('steal_pct'))} %, other programs {_f(noise.get('others_pct'), 0)} %, "
+        f"load {_f(noise.get('load1'), 2)}"
     )
-    out: list[Any] = [header]
+    legend = Text(
+        "Noise beside every row: steal % = CPU the VM host took; others % = machine CPU (all cores) used by "
+        "other programs, forkserver-started pool workers included; load = 1-minute load average.",
+        style="dim",
+    )
+    out: list[Any] = [header, legend]
     for name, part in doc.get("parts", {}).items():
         if "error" in part:
             out.append(Text(f"{name}: {part['error']}"))

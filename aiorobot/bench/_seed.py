@@ -6,7 +6,8 @@ A 50 Hz control timer beside a perception timer doing 150 ms of work every
 
 - ``single``: one asyncio loop, perception inline (rclpy's SingleThreadedExecutor);
 - ``threads``: rclpy's MultiThreadedExecutor(4) with one callback group each;
-- ``aiorobot``: control on the priority loop, perception through ``Node.offload``.
+- ``aiorobot``: control on the priority loop, perception through ``Node.offload``;
+- ``aiorobot-rt``: the same on ``Runtime(priority_realtime=True)`` (SCHED_FIFO).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from ._workload import KINDS
 
 __all__ = ["MODELS", "REFERENCE", "run"]
 
-MODELS = ("single", "threads", "aiorobot")
+MODELS = ("single", "threads", "aiorobot", "aiorobot-rt")
 
 #: The seed's published rclpy figures (ms), printed as reference rows.
 REFERENCE: dict[str, dict[str, float | str]] = {
@@ -32,7 +33,7 @@ REFERENCE: dict[str, dict[str, float | str]] = {
 }
 
 
-def _model_runner(model: str) -> Callable[[str, SeedConfig], list[float]]:
+def _model_runner(model: str) -> Callable[..., list[float]]:
     if model == "single":
         from ._model_single import run_single
 
@@ -45,15 +46,24 @@ def _model_runner(model: str) -> Callable[[str, SeedConfig], list[float]]:
         from ._model_aiorobot import run_aiorobot
 
         return run_aiorobot
+    if model == "aiorobot-rt":
+        from ._model_aiorobot import run_aiorobot_rt
+
+        return run_aiorobot_rt
     raise ValueError(f"executor model must be one of {MODELS}, received {model!r}")
 
 
 def run_model(model: str, kind: str, cfg: SeedConfig) -> dict[str, Any]:
     """One model under one perception kind: period figures, raw periods and noise."""
     runner = _model_runner(model)
+    applied: list[str] = []
     with NoiseMeter() as meter:
         t0 = time.perf_counter()
-        stamps = runner(kind, cfg)[: cfg.stamps_needed]
+        if model.startswith("aiorobot"):
+            stamps = runner(kind, cfg, applied=applied)
+        else:
+            stamps = runner(kind, cfg)
+        stamps = stamps[: cfg.stamps_needed]
         wall = time.perf_counter() - t0
     if len(stamps) < cfg.stamps_needed:
         raise RuntimeError(
@@ -65,6 +75,7 @@ def run_model(model: str, kind: str, cfg: SeedConfig) -> dict[str, Any]:
         "stats": period_stats(periods, cfg.nominal_ms).as_dict(),
         "periods_ms": [round(p, 4) for p in periods],
         "wall_sec": round(wall, 3),
+        "scheduling": " ".join(applied) or "default",
         "noise": meter.result.as_dict(),
     }
 

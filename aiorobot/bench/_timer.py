@@ -1,8 +1,9 @@
 """Part ``timer``: precision of a 1 kHz timer on the priority loop.
 
 A node with a 1 ms timer runs on the priority loop for ``duration_sec`` (5 s;
-quick: 0.5 s), twice: once with the main loop idle and once while the main loop
-is busy with pure-Python work (1 ms slices back to back, yielding to the loop
+quick: 0.3 s), with ``Runtime()`` and with ``Runtime(priority_realtime=True)``
+(SCHED_FIFO where permitted), each once with the main loop idle and once while
+the main loop is busy with pure-Python work (1 ms slices back to back, yielding to the loop
 between slices: it holds the GIL nearly all the time, like a loaded
 application). Reported: the period error (|period - 1 ms|) p50/p99/max, the
 timer's own lateness figures (``Timer.stats``) and the CPU the priority thread
@@ -25,7 +26,7 @@ PERIOD_SEC = 0.001
 _WARMUP = 20
 
 
-async def _measure(duration_sec: float, busy_main: bool) -> dict[str, Any]:
+async def _measure(duration_sec: float, busy_main: bool, realtime: bool = False) -> dict[str, Any]:
     from aiorobot import Node, Runtime
 
     n_ticks = _WARMUP + round(duration_sec / PERIOD_SEC) + 1
@@ -54,12 +55,13 @@ async def _measure(duration_sec: float, busy_main: bool) -> dict[str, Any]:
                 python_chunk(0.001)
                 await asyncio.sleep(0)
 
-    async with Runtime(handle_signals=False) as rt:
+    async with Runtime(handle_signals=False, priority_realtime=realtime) as rt:
         ticker = Ticker()
         ticker.done = rt.shutdown  # type: ignore[attr-defined]
         rt.add_node(ticker, executor="priority")
         if busy_main:
             rt.add_node(Busy("busy"))
+        applied = list(rt.priority_loop.applied) if rt.priority_loop is not None else []
         await rt.spin()
         stats = ticker.timer.stats
     stamps = ticker.stamps[:n_ticks]
@@ -67,6 +69,8 @@ async def _measure(duration_sec: float, busy_main: bool) -> dict[str, Any]:
     wall = stamps[-1] - stamps[_WARMUP]
     errors_us = [abs(p - PERIOD_SEC * 1e3) * 1e3 for p in periods_ms]
     return {
+        "runtime": "Runtime(priority_realtime=True)" if realtime else "Runtime()",
+        "scheduling": " ".join(applied) or "default",
         "main_loop": "busy (pure Python)" if busy_main else "idle",
         "period_error": latency_stats(errors_us).as_dict(),
         "lateness_us": {
@@ -87,9 +91,9 @@ def run(quick: bool = False) -> dict[str, Any]:
     duration = 0.3 if quick else 5.0
     rows = []
     with NoiseMeter() as part_meter:
-        for busy in (False, True):
+        for realtime, busy in ((False, False), (False, True), (True, False), (True, True)):
             with NoiseMeter() as meter:
-                row = aiorobot.run(_measure(duration, busy))
+                row = aiorobot.run(_measure(duration, busy, realtime))
             assert meter.result is not None
             row["noise"] = meter.result.as_dict()
             rows.append(row)

@@ -53,9 +53,14 @@ def test_json_holds_every_part_model_and_kind(quick_run) -> None:
             assert "error" not in res, res
             assert res["stats"]["samples"] == seed["config"]["periods"] == len(res["periods_ms"])
             assert set(res["stats"]) >= {"mean_ms", "stdev_ms", "p50_ms", "p99_ms", "max_ms", "late_1ms", "late_5ms"}
-            assert set(res["noise"]) == {"wall_sec", "steal_pct", "busy_pct", "load1"}
+            assert set(res["noise"]) == {"wall_sec", "steal_pct", "busy_pct", "load1", "others_pct"}
     assert seed["reference"]["rclpy SingleThreadedExecutor"]["max_ms"] == 172.1
-    assert [r["main_loop"] for r in doc["parts"]["timer"]["rows"]] == ["idle", "busy (pure Python)"]
+    assert [(r["runtime"], r["main_loop"]) for r in doc["parts"]["timer"]["rows"]] == [
+        ("Runtime()", "idle"),
+        ("Runtime()", "busy (pure Python)"),
+        ("Runtime(priority_realtime=True)", "idle"),
+        ("Runtime(priority_realtime=True)", "busy (pure Python)"),
+    ]
     for row in doc["parts"]["timer"]["rows"]:
         assert set(row["period_error"]) >= {"p50_us", "p99_us", "max_us"} and "thread_cpu_pct" in row
     paths = {(r["path"], r["payload"]) for r in doc["parts"]["latency"]["rows"]}

@@ -41,6 +41,15 @@ def test_noise_between_gives_steal_and_busy_shares_of_the_interval() -> None:
     assert sample.steal_pct == pytest.approx(100 * 20 / 150)
     assert sample.busy_pct == pytest.approx(100 * 80 / 150)
     assert (sample.wall_sec, sample.load1) == (1.5, 0.7)
+    assert sample.others_pct is None
+
+
+def test_noise_between_subtracts_our_own_cpu_from_the_busy_share() -> None:
+    before = CpuTimes(100, 0, 50, 800, 0, 0, 0, 50)
+    after = CpuTimes(160, 0, 70, 850, 0, 0, 0, 70)  # 80 busy ticks of 150
+    sample = noise_between(before, after, wall_sec=1.5, load1=0.7, own_ticks=30)
+    assert sample.others_pct == pytest.approx(100 * 50 / 150)
+    assert noise_between(before, after, 1.5, 0.7, own_ticks=500).others_pct == 0.0
 
 
 def test_noise_between_an_empty_interval_is_quiet() -> None:
@@ -53,4 +62,4 @@ def test_noise_meter_reports_after_its_block() -> None:
         assert meter.result is None
     assert meter.result is not None
     assert meter.result.wall_sec >= 0.0
-    assert set(meter.result.as_dict()) == {"wall_sec", "steal_pct", "busy_pct", "load1"}
+    assert set(meter.result.as_dict()) == {"wall_sec", "steal_pct", "busy_pct", "load1", "others_pct"}
