@@ -23,6 +23,7 @@ _EXPORTS = {
     "Client": "_services",
     "ClientGoalHandle": "_actions",
     "Clock": "_clock",
+    "ClockPublisher": "_clock_publisher",
     "ClockType": "_time",
     "ConfigError": "_config",
     "DurabilityPolicy": "_qos",
@@ -81,6 +82,7 @@ __all__ = [
     "Client",
     "ClientGoalHandle",
     "Clock",
+    "ClockPublisher",
     "ClockType",
     "ConfigError",
     "DurabilityPolicy",
@@ -134,6 +136,7 @@ __all__ = [
 if TYPE_CHECKING:
     from ._actions import ActionClient, ActionServer, CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
     from ._clock import Clock
+    from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo

@@ -2,31 +2,12 @@
 
 from __future__ import annotations
 
-from .._node import Node
-from .._qos import QoSProfile
+from .._clock_publisher import ClockPublisher
 from .._runtime import Runtime
-from .._time import Duration, Time
+from .._time import Duration
 from ._settle import settle
 
 __all__ = ["ClockPublisher", "SimClock"]
-
-
-class ClockPublisher(Node):
-    """Publishes ``rosgraph_msgs/msg/Clock`` on ``/clock`` when told to (simulators, bag playback)."""
-
-    def __init__(self, name: str = "sim_clock", **kw: object) -> None:
-        super().__init__(name, **kw)  # type: ignore[arg-type]
-        from ..msgs.rosgraph_msgs import Clock
-
-        self._msg_type = Clock
-        self._pub = self.create_publisher(Clock, "/clock", QoSProfile(depth=1))
-        self.time_ns = 0
-
-    def publish_time(self, nanoseconds: int) -> None:
-        self.time_ns = nanoseconds
-        msg = self._msg_type()
-        msg.clock = Time(nanoseconds=nanoseconds).to_msg()
-        self._pub.publish(msg)
 
 
 class SimClock:
