@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -158,7 +159,9 @@ class Bus:
             else:
                 sub.node._call_soon(sub._enqueue, msg)
 
-    def preview(self, publishers: list[Publisher], subscriptions: list[Sub]) -> list[tuple[Publisher, Sub, str]]:
+    def preview(
+        self, publishers: Sequence[Publisher], subscriptions: Sequence[Sub]
+    ) -> list[tuple[Publisher, Sub, str]]:
         """The pairs that would not connect if these endpoints joined, without registering them.
 
         Lets a runtime refuse a whole set of nodes under ``strict_qos`` before any starts.

@@ -344,7 +344,7 @@ def _flatten_parameters(
             elif len(kinds) > 1:
                 raise checker.error(
                     value_key,
-                    f"expected an array of one type, found an array mixing {' and '.join(sorted(kinds))}",
+                    f"expected an array of one type, found an array mixing {' and '.join(sorted(str(k) for k in kinds))}",
                 )
             out[prefix + name] = tuple(value)
             continue

@@ -464,7 +464,7 @@ class Node:
 
     def _create_task(self, coro: Awaitable[Any], *, name: str | None = None) -> asyncio.Task[Any]:
         assert self._loop is not None
-        task = self._loop.create_task(coro, name=name)  # type: ignore[arg-type]
+        task: asyncio.Task[Any] = self._loop.create_task(coro, name=name)  # type: ignore[arg-type]
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
         return task

@@ -30,7 +30,7 @@ _BATCH = 64
 
 
 def _type_name(msg_type: Any) -> str:
-    return getattr(msg_type, "__msgtype__", None) or getattr(msg_type, "__name__", repr(msg_type))
+    return str(getattr(msg_type, "__msgtype__", None) or getattr(msg_type, "__name__", repr(msg_type)))
 
 
 class Endpoint:
@@ -61,6 +61,7 @@ class Publisher(Endpoint, Generic[M]):
     """Publishes messages of one type on one topic; created by ``Node.create_publisher``."""
 
     kind = "publisher"
+    node: Node
 
     def __init__(self, node: Node, msg_type: type[M], topic: str, qos: QoSProfile) -> None:
         super().__init__(node, msg_type, topic, qos)
@@ -69,6 +70,7 @@ class Publisher(Endpoint, Generic[M]):
         )
         self._subs: tuple[Subscription | Tap, ...] = ()
         self._same_loop: tuple[Subscription, ...] = ()
+        self._own_loop: asyncio.AbstractEventLoop | None = None
         self._other_loops: tuple[tuple[asyncio.AbstractEventLoop, tuple[Subscription, ...]], ...] = ()
         self._taps: tuple[Tap, ...] = ()
         self._thread_id: int | None = None
@@ -86,18 +88,20 @@ class Publisher(Endpoint, Generic[M]):
 
     def _set_targets(self, subs: tuple[Subscription | Tap, ...]) -> None:
         """Install the matched subscriptions (called by the bus under its lock)."""
-        own_loop = self.node._loop if self.node is not None else None
-        self._thread_id = self.node._thread_id if self.node is not None else None
+        own_loop = self.node._loop
+        self._thread_id = self.node._thread_id
+        self._own_loop = own_loop
         same: list[Subscription] = []
         other: dict[asyncio.AbstractEventLoop, list[Subscription]] = {}
         taps: list[Tap] = []
         for sub in subs:
+            loop = None if isinstance(sub, Tap) else sub.node._loop
             if isinstance(sub, Tap):
                 taps.append(sub)
-            elif sub.node._loop is own_loop:
+            elif loop is own_loop:
                 same.append(sub)
-            else:
-                other.setdefault(sub.node._loop, []).append(sub)
+            elif loop is not None:
+                other.setdefault(loop, []).append(sub)
         self._subs = subs
         self._same_loop = tuple(same)
         self._other_loops = tuple((loop, tuple(group)) for loop, group in other.items())
@@ -120,16 +124,15 @@ class Publisher(Endpoint, Generic[M]):
             for loop, subs in self._other_loops:
                 _call_threadsafe(loop, _enqueue_all, subs, msg)
         else:
-            for sub in self._same_loop:
-                _call_threadsafe(sub.node._loop, sub._enqueue, msg)
+            if self._same_loop and self._own_loop is not None:
+                _call_threadsafe(self._own_loop, _enqueue_all, self._same_loop, msg)
             for loop, subs in self._other_loops:
                 _call_threadsafe(loop, _enqueue_all, subs, msg)
         for tap in self._taps:
             tap._enqueue(msg)
 
     def destroy(self) -> None:
-        if self.node is not None:
-            self.node.destroy_publisher(self)
+        self.node.destroy_publisher(self)
 
 
 def _enqueue_all(subs: tuple[Subscription, ...], msg: Any) -> None:
@@ -171,6 +174,7 @@ class Subscription(Endpoint, Generic[M]):
     """Receives messages of one topic into a QoS-bounded queue; a dispatcher runs the callback."""
 
     kind = "subscription"
+    node: Node
 
     def __init__(
         self,
@@ -222,7 +226,7 @@ class Subscription(Endpoint, Generic[M]):
                 waiter.set_result(None)
 
     async def _wait(self) -> None:
-        waiter = self.node._loop.create_future()
+        waiter = asyncio.get_running_loop().create_future()  # always the node's loop
         self._waiter = waiter
         try:
             await waiter
@@ -269,8 +273,7 @@ class Subscription(Endpoint, Generic[M]):
         self._busy -= 1
 
     def destroy(self) -> None:
-        if self.node is not None:
-            self.node.destroy_subscription(self)
+        self.node.destroy_subscription(self)
 
 
 class MessageStream(Generic[M]):

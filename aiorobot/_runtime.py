@@ -80,7 +80,7 @@ class Runtime:
         if config is not None:
             from ._config import load_config
 
-            cfg = load_config(config) if isinstance(config, (str, os.PathLike)) else config
+            cfg = load_config(os.fspath(config)) if isinstance(config, (str, os.PathLike)) else config
             self._config = cfg
             transport = cfg.runtime.transport
             domain_id = cfg.runtime.domain_id
@@ -213,8 +213,10 @@ class Runtime:
                 self._bus.remove(endpoint)
             node._unbind()
             raise
-        for endpoint in [*node._services, *node._clients]:
-            self._bus.services.add(endpoint)
+        for service in node._services:
+            self._bus.services.add(service)
+        for client in node._clients:
+            self._bus.services.add(client)
         self._nodes.append(node)
         node._call_soon(node._start)
         return node
@@ -255,8 +257,10 @@ class Runtime:
     def _detach(self, node: Node) -> None:
         for endpoint in [*node._publishers, *node._subscriptions]:
             self._bus.remove(endpoint)
-        for service in [*node._services, *node._clients]:
+        for service in node._services:
             self._bus.services.remove(service)
+        for client in node._clients:
+            self._bus.services.remove(client)
         loop = node._loop
         if loop is not None and not loop.is_closed():
             if loop is self._loop:
@@ -300,7 +304,7 @@ class Runtime:
                 assert self._loop is not None
                 self._loop.remove_signal_handler(sig)
 
-    def _install_signal_handlers(self) -> list[int]:
+    def _install_signal_handlers(self) -> list[signal.Signals]:
         if not self._handle_signals or threading.current_thread() is not threading.main_thread():
             return []
         installed = []

@@ -32,7 +32,7 @@ class ServiceUnavailableError(ServiceError):
 
 
 def _srv_name(srv_type: Any) -> str:
-    return getattr(srv_type, "__msgtype__", None) or getattr(srv_type, "__name__", repr(srv_type))
+    return str(getattr(srv_type, "__msgtype__", None) or getattr(srv_type, "__name__", repr(srv_type)))
 
 
 def check_srv_type(srv_type: Any) -> None:

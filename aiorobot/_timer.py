@@ -141,12 +141,13 @@ class Timer:
     async def _sleep_until(self, deadline: int) -> None:
         """Wait for the deadline, or for cancel/reset to poke us."""
         node = self.node
-        wake = node._loop.create_future()
+        wake = asyncio.get_running_loop().create_future()  # the node's loop
         self._wake = wake
         clock = node._clock
         if clock.use_sim_time:
             clock.add_waiter(deadline, wake)
         else:
+            assert node._waker is not None, "a running timer belongs to a bound node"
             node._waker.add(deadline, wake)
         try:
             await wake  # raises ClockJump when sim time jumps back
@@ -155,7 +156,7 @@ class Timer:
 
     async def _run(self) -> None:
         node = self.node
-        loop = node._loop
+        loop = asyncio.get_running_loop()
         while True:
             if self._cancelled:
                 wake = loop.create_future()
@@ -243,6 +244,9 @@ class Rate:
             if clock.use_sim_time:
                 await clock.sleep_until_ns(deadline)
             else:
-                await self.node._waker.wait_until_ns(deadline)
+                waker = self.node._waker
+                if waker is None:
+                    raise RuntimeError(f"{self!r}: the node is not added to a runtime")
+                await waker.wait_until_ns(deadline)
         except ClockJump:
             self._next_ns = None
