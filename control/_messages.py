@@ -9,7 +9,7 @@ from __future__ import annotations
 import enum
 import struct
 from dataclasses import dataclass
-from typing import ClassVar, Union
+from typing import Any, ClassVar, Union
 
 from ._framing import MAX_PAYLOAD_BYTES, FrameError, FrameErrorKind, Packet, encode_packet
 
@@ -138,8 +138,15 @@ class EmergencyStop:
 
 @dataclass(frozen=True, slots=True)
 class _Empty:
+    """A message without payload."""
+
     def pack(self) -> bytes:
         return b""
+
+    @classmethod
+    def unpack(cls, payload: bytes) -> Any:
+        _fixed(payload, 0, cls.__name__)
+        return cls()
 
 
 @dataclass(frozen=True, slots=True)
@@ -148,11 +155,6 @@ class ClearEmergencyStop(_Empty):
 
     MSG_ID: ClassVar[int] = MsgId.CLEAR_EMERGENCY_STOP
 
-    @classmethod
-    def unpack(cls, payload: bytes) -> ClearEmergencyStop:
-        _fixed(payload, 0, "ClearEmergencyStop")
-        return cls()
-
 
 @dataclass(frozen=True, slots=True)
 class VersionRequest(_Empty):
@@ -160,22 +162,12 @@ class VersionRequest(_Empty):
 
     MSG_ID: ClassVar[int] = MsgId.VERSION_REQUEST
 
-    @classmethod
-    def unpack(cls, payload: bytes) -> VersionRequest:
-        _fixed(payload, 0, "VersionRequest")
-        return cls()
-
 
 @dataclass(frozen=True, slots=True)
 class ResetEncoders(_Empty):
     """Host -> firmware, 0x06: set every encoder counter to zero."""
 
     MSG_ID: ClassVar[int] = MsgId.RESET_ENCODERS
-
-    @classmethod
-    def unpack(cls, payload: bytes) -> ResetEncoders:
-        _fixed(payload, 0, "ResetEncoders")
-        return cls()
 
 
 @dataclass(frozen=True, slots=True)
