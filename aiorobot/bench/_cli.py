@@ -10,6 +10,7 @@ import argparse
 import json
 import os
 import sys
+from typing import Any
 from ._runner import PARTS
 
 __all__ = ["add_arguments", "main"]
@@ -106,7 +107,7 @@ def main(args: argparse.Namespace) -> int:
     return 1 if _failures(doc) else 0
 
 
-def _failures(doc: dict) -> list[str]:
+def _failures(doc: dict[str, Any]) -> list[str]:
     """Parts (and seed models) that could not run."""
     failed = []
     for name, part in doc["parts"].items():

@@ -12,14 +12,18 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ._seedconfig import SeedConfig
 from ._workload import work_function
 
+if TYPE_CHECKING:
+    from aiorobot import Node
+
 __all__ = ["run_aiorobot", "run_aiorobot_rt"]
 
 
-def _nodes(kind: str, cfg: SeedConfig, done: Callable[[], None]) -> tuple[object, object]:
+def _nodes(kind: str, cfg: SeedConfig, done: Callable[[], None]) -> tuple[Node, Node]:
     from aiorobot import Node
 
     class Control(Node):
@@ -59,7 +63,7 @@ async def _main(kind: str, cfg: SeedConfig, realtime: bool, applied: list[str]) 
         if rt.priority_loop is not None:
             applied.extend(rt.priority_loop.applied)
         await rt.spin()
-    return list(control.stamps)  # type: ignore[attr-defined]
+    return list(getattr(control, "stamps"))
 
 
 def run_aiorobot(kind: str, cfg: SeedConfig, *, realtime: bool = False, applied: list[str] | None = None) -> list[float]:

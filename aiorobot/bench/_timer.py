@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import asyncio
 import time
+from collections.abc import Callable
 from typing import Any
 
 from ._noise import NoiseMeter
@@ -32,8 +33,9 @@ async def _measure(duration_sec: float, busy_main: bool, realtime: bool = False)
     n_ticks = _WARMUP + round(duration_sec / PERIOD_SEC) + 1
 
     class Ticker(Node):
-        def __init__(self) -> None:
+        def __init__(self, done: Callable[[], None]) -> None:
             super().__init__("ticker")
+            self.done = done
             self.stamps: list[float] = []
             self.cpu_sec = [0.0, 0.0]
             self.timer = self.create_timer(PERIOD_SEC, self.tick)
@@ -56,8 +58,7 @@ async def _measure(duration_sec: float, busy_main: bool, realtime: bool = False)
                 await asyncio.sleep(0)
 
     async with Runtime(handle_signals=False, priority_realtime=realtime) as rt:
-        ticker = Ticker()
-        ticker.done = rt.shutdown  # type: ignore[attr-defined]
+        ticker = Ticker(rt.shutdown)
         rt.add_node(ticker, executor="priority")
         if busy_main:
             rt.add_node(Busy("busy"))
