@@ -69,7 +69,8 @@ def _seed_table(part: dict[str, Any]) -> Any:
         "single: one asyncio loop, perception inline | threads: rclpy MultiThreadedExecutor(4) model, "
         "one group each | aiorobot: control on the priority loop, perception via Node.offload; aiorobot-rt: the same with "
         "Runtime(priority_realtime=True) (SCHED_FIFO). "
-        "sleep releases the GIL, cpu holds it. Dim rows: the seed's published rclpy figures."
+        "sleep releases the GIL, cpu holds it. Dim rows: the seed's published rclpy figures (its own script; here "
+        "perception asks for 150 % of one thread, so one thread gives control a single tick per perception run)."
     )
     return table
 
