@@ -71,10 +71,9 @@ def test_models_record_every_control_callback_asked_for(runner, kind: str) -> No
     assert stamps == sorted(stamps)
 
 
-def test_work_functions_take_the_time_asked_for() -> None:
+def test_work_function_maps_each_kind_and_rejects_others() -> None:
     assert work_function("sleep") is sleep_work
     assert work_function("cpu") is cpu_work
-    assert cpu_work(0.002) >= 0.002
     with pytest.raises(ValueError, match=r"one of \('sleep', 'cpu'\), received 'gpu'"):
         work_function("gpu")
 
