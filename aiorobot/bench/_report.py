@@ -87,14 +87,18 @@ def _timer_table(part: dict[str, Any]) -> Any:
         table.add_column(col, justify="left" if col in ("main loop", "priority thread") else "right")
     for row in part.get("rows", []):
         e, late = row["period_error"], row["lateness_us"]
+        floor = "floor" in row.get("runtime", "")
         table.add_row(
-            row.get("scheduling", "-"), row["main_loop"], _f(e["p50_us"]), _f(e["p99_us"]), _f(e["max_us"]),
+            ("[dim]floor: [/dim]" if floor else "") + row.get("scheduling", "-"),
+            row["main_loop"],
+            _f(e["p50_us"]), _f(e["p99_us"]), _f(e["max_us"]),
             _f(late["p50_us"]), _f(late["p99_us"]), _f(late["max_us"]),
             _f(row["overruns"]), _f(row["thread_cpu_pct"], 2), *_noise(row.get("noise")),
         )
     table.add_row("[dim]target[/dim]", "", "", "[dim]<= 100[/dim]", "[dim]<= 500[/dim]", "", "", "", "", "[dim]< 10[/dim]", "", "", "")
     table.caption = (
         "priority thread: Runtime() gives timerslack=1ns; Runtime(priority_realtime=True) adds SCHED_FIFO where permitted. "
+        "floor: a bare Python thread sleeping to the same deadlines with clock_nanosleep (no loop): what the machine allows. "
         "error: |period - nominal|; late: start after deadline (Timer.stats); CPU: the priority thread's CPU time over wall time"
     )
     return table

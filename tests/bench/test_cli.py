@@ -60,6 +60,8 @@ def test_json_holds_every_part_model_and_kind(quick_run) -> None:
         ("Runtime()", "busy (pure Python)"),
         ("Runtime(priority_realtime=True)", "idle"),
         ("Runtime(priority_realtime=True)", "busy (pure Python)"),
+        ("bare thread, clock_nanosleep (floor)", "idle"),
+        ("bare thread, clock_nanosleep (floor)", "idle"),
     ]
     for row in doc["parts"]["timer"]["rows"]:
         assert set(row["period_error"]) >= {"p50_us", "p99_us", "max_us"} and "thread_cpu_pct" in row
