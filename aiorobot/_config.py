@@ -47,7 +47,14 @@ TRANSPORTS = ("local", "zenoh")
 _AVAILABLE_TRANSPORTS = ("local",)
 _MAX_DOMAIN_ID = 232
 
-_RUNTIME_KEYS = ("transport", "domain_id", "use_sim_time", "strict_qos", "log_level")
+_RUNTIME_KEYS = (
+    "transport",
+    "domain_id",
+    "use_sim_time",
+    "strict_qos",
+    "log_level",
+    "priority_realtime",
+)
 _NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level")
 _RECORD_KEYS = ("path",)
 _TOP_KEYS = ("runtime", "nodes", "record")
@@ -96,6 +103,7 @@ class RuntimeConfig:
     use_sim_time: bool = False
     strict_qos: bool = False
     log_level: str = "info"
+    priority_realtime: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -229,7 +237,9 @@ def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
     strict_qos = table.get("strict_qos", False)
     checker.check_type(strict_qos, "runtime.strict_qos", bool, "true or false")
     log_level = checker.choice(table, "runtime", "log_level", LOG_LEVELS, "info")
-    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level)
+    realtime = table.get("priority_realtime", False)
+    checker.check_type(realtime, "runtime.priority_realtime", bool, "true or false")
+    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level, realtime)
 
 
 def _parse_nodes(checker: _Checker, data: Mapping[str, Any]) -> tuple[NodeConfig, ...]:
@@ -399,9 +409,9 @@ class _Checker:
                     f"unknown key{hint} (expected one of: {', '.join(allowed)})",
                 )
 
-    def check_type(self, value: Any, key: str, expected_type: type, expected: str) -> None:
+    def check_type(self, value: Any, key: str, expected_type: type | tuple[type, ...], expected: str) -> None:
         ok = isinstance(value, expected_type)
-        if expected_type is int and isinstance(value, bool):
+        if expected_type is not bool and isinstance(value, bool):
             ok = False
         if not ok:
             raise self.error(key, f"expected {expected}, found {_found(value)}")
