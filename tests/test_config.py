@@ -227,3 +227,12 @@ def test_multiline_messages_are_folded_into_one_line() -> None:
     err = ConfigError("a.toml", "nodes[0]", "first line\n  second line\n")
     assert str(err) == "a.toml: nodes[0]: first line second line"
     assert str(ConfigError("a.toml", None, "cannot read")) == "a.toml: cannot read"
+
+
+def test_priority_realtime_reaches_the_runtime(tmp_path):
+    from aiorobot import Runtime
+
+    path = tmp_path / "rt.toml"
+    path.write_text('[runtime]\npriority_realtime = true\n\n[[nodes]]\nuse = "aiorobot.examples.sensor:ImuPublisher"\n')
+    assert load_config(path).runtime.priority_realtime is True
+    assert Runtime(config=path)._priority_realtime is True
