@@ -29,15 +29,11 @@ from aiorobot.control import (  # noqa: E402
     SimulatedFirmware,
     SimulatedFirmwareNode,
 )
+from _helpers import wait_until  # noqa: E402
 
 JOINTS = ["front_left_wheel_joint", "front_right_wheel_joint", "rear_left_wheel_joint", "rear_right_wheel_joint"]
 
 
-async def wait_until(predicate, timeout_sec=15.0):
-    """Poll a condition on the event loop; returns as soon as it holds (no fixed sleeps)."""
-    async with asyncio.timeout(timeout_sec):
-        while not predicate():
-            await asyncio.sleep(0.005)
 
 
 class Probe(Node):

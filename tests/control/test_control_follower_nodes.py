@@ -17,12 +17,9 @@ from aiorobot.msgs.geometry_msgs import PoseStamped, Twist  # noqa: E402
 from aiorobot.msgs.nav_msgs import Odometry, Path  # noqa: E402
 
 from aiorobot.control import GoToGoalController, PurePursuitController, integrate_twist, path_from_msg  # noqa: E402
+from _helpers import wait_until  # noqa: E402
 
 
-async def wait_until(predicate, timeout_sec=30.0):
-    async with asyncio.timeout(timeout_sec):
-        while not predicate():
-            await asyncio.sleep(0.005)
 
 
 class UnicycleSim(Node):

@@ -18,13 +18,9 @@ from aiorobot.msgs.nav_msgs import Odometry  # noqa: E402
 from aiorobot.msgs.sensor_msgs import JointState  # noqa: E402
 
 from aiorobot.control import DiffDriveController, MecanumController  # noqa: E402
+from _helpers import wait_until  # noqa: E402
 
 
-async def wait_until(predicate, timeout_sec=10.0):
-    """Poll a condition on the event loop; returns as soon as it holds (no fixed sleeps)."""
-    async with asyncio.timeout(timeout_sec):
-        while not predicate():
-            await asyncio.sleep(0.005)
 
 
 class Probe(Node):

@@ -16,13 +16,9 @@ from aiorobot.control import (
     VersionRequest,
     VersionResponse,
 )
+from _helpers import wait_until  # noqa: E402
 
 
-async def wait_until(predicate, timeout_sec=10.0):
-    """Poll a condition on the event loop (no fixed sleeps: returns as soon as it holds)."""
-    async with asyncio.timeout(timeout_sec):
-        while not predicate():
-            await asyncio.sleep(0.005)
 
 
 async def test_link_exchanges_packets_with_pty_firmware(tmp_path):
