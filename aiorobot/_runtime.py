@@ -17,7 +17,7 @@ from ._clock import Clock
 from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._node import Node
 from ._priority import PriorityLoop
-from ._pubsub import Publisher, Tap
+from ._pubsub import Tap
 from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
 from ._transport import Transport, make_transport

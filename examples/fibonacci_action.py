@@ -7,7 +7,6 @@
 from __future__ import annotations
 
 import argparse
-import asyncio
 
 import aiorobot
 from aiorobot import CancelResponse, GoalResponse, Node, Runtime

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import math
 
 import numpy as np
@@ -135,7 +134,7 @@ async def test_odometry_integrates_wheel_positions_from_joint_states():
             msg.position = np.array([float(i), float(i)])
             msg.velocity = np.array([10.0, 10.0])
             probe.joint_pub.publish(msg)
-            await wait_until(lambda: len(probe.odom) > i)
+            await wait_until(lambda i=i: len(probe.odom) > i)
         assert len(probe.odom) == 11  # the first reading only sets the reference
         odom = probe.odom[-1]
         assert odom.header.frame_id == "odom" and odom.child_frame_id == "base_link"

@@ -21,7 +21,7 @@ def test_ordering():
 
 def test_times_of_different_clocks_do_not_mix():
     with pytest.raises(TypeError, match="different clocks"):
-        Time(seconds=1) < Time(seconds=1, clock_type=ClockType.STEADY_TIME)
+        _ = Time(seconds=1) < Time(seconds=1, clock_type=ClockType.STEADY_TIME)
 
 
 def test_negative_time_is_rejected():
