@@ -208,6 +208,8 @@ class Node:
             raise TypeError(f"timer callback must be callable, got {callback!r}")
         timer = Timer(self, period_sec, callback, callback_group or self._default_group, autostart=autostart)
         self._timers.append(timer)
+        if self._loop is not None and autostart:
+            timer._anchor()
         if self._started and autostart:
             self._call_soon(timer._start)
         return timer
@@ -443,6 +445,9 @@ class Node:
         self._waker = waker
         self._clock = runtime.clock
         self._logger._bind_clock(runtime.clock)
+        for timer in self._timers:
+            if not timer._cancelled:
+                timer._anchor()
 
     def _unbind(self) -> None:
         self._runtime = None

@@ -128,9 +128,15 @@ class Timer:
         if wake is not None and not wake.done():
             wake.set_result(None)
 
+    def _anchor(self) -> None:
+        """Start the deadline grid now. Called on the thread that adds the node or creates the
+        timer, so a clock that moves before the node's loop picks the timer up cannot shift it."""
+        self._next_ns = self._now() + self.period_ns
+
     def _start(self) -> None:
         if self._task is None and not self.destroyed:
-            self._next_ns = self._now() + self.period_ns
+            if self._next_ns is None:
+                self._anchor()
             self._restart = False
             self._task = self.node._create_task(self._run(), name=f"timer {self.period_ns / 1e9:g}s of {self.node.get_fully_qualified_name()}")
 

@@ -169,3 +169,12 @@ async def test_rate_sleeps_on_sim_time(sim_runtime, sim_clock):
     await sim_clock.advance(0.35)
     await task
     assert stamps == [1_100_000_000, 1_200_000_000, 1_300_000_000]
+
+
+async def test_priority_loop_timer_follows_sim_time(sim_runtime, sim_clock):
+    node = sim_runtime.add_node(Ticker(0.1), executor="priority")
+    await sim_clock.advance(0.35)
+    assert node.ticks == [1_100_000_000, 1_200_000_000, 1_300_000_000]
+    await sim_clock.set(0.5)  # a backwards jump reaches the other thread's timer too
+    await sim_clock.advance(0.1)
+    assert node.ticks[-1] == 600_000_000
