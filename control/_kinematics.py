@@ -24,9 +24,14 @@ def _out(array: NDArray[np.float64]) -> Any:
 class Kinematics(Protocol):
     """What the base controller and odometry need from a drive."""
 
-    wheel_radius: float
-    n_wheels: int
-    wheel_names: tuple[str, ...]
+    @property
+    def wheel_radius(self) -> float: ...
+
+    @property
+    def n_wheels(self) -> int: ...
+
+    @property
+    def wheel_names(self) -> tuple[str, ...]: ...
 
     def wheel_speeds(self, body_twist: ArrayLike) -> NDArray[np.float64]: ...
 

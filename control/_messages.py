@@ -245,8 +245,9 @@ class VersionResponse:
             raise FrameError(
                 FrameErrorKind.GARBAGE, f"VersionResponse payload must be {size}..{size + MAX_NAME_BYTES} bytes, got {len(payload)}"
             )
-        fields = _VERSION_HEADER.unpack_from(payload)
-        return cls(*fields, name=payload[size:].decode("utf-8", errors="replace"))
+        protocol, major, minor, patch, wheels, ticks = _VERSION_HEADER.unpack_from(payload)
+        name = payload[size:].decode("utf-8", errors="replace")
+        return cls(protocol, major, minor, patch, wheels, ticks, name=name)
 
 
 Message = Union[
@@ -261,7 +262,7 @@ Message = Union[
     VersionResponse,
 ]
 
-_BY_ID: dict[int, type] = {
+_BY_ID: dict[int, Any] = {
     cls.MSG_ID: cls
     for cls in (
         SetWheelVelocities,
@@ -295,7 +296,8 @@ def decode_message(packet: Packet) -> Message:
     if cls is None:
         raise FrameError(FrameErrorKind.GARBAGE, f"unknown message id 0x{packet.msg_id:02X}")
     try:
-        return cls.unpack(packet.payload)  # type: ignore[no-any-return]
+        message: Message = cls.unpack(packet.payload)
+        return message
     except (struct.error, ValueError) as exc:
         if isinstance(exc, FrameError):
             raise

@@ -151,7 +151,9 @@ class WheelOdometry:
         if counts.shape != (self.kinematics.n_wheels,):
             raise ValueError(f"ticks must have shape ({self.kinematics.n_wheels},), got shape {counts.shape}")
         if self._last_ticks is not None and self._last_stamp_sec is not None:
-            delta_rad = tick_delta(counts, self._last_ticks) * (2.0 * math.pi / self.ticks_per_revolution)
+            delta_rad = np.asarray(tick_delta(counts, self._last_ticks), dtype=np.float64) * (
+                2.0 * math.pi / self.ticks_per_revolution
+            )
             self._apply_increment(delta_rad, float(stamp_sec) - self._last_stamp_sec)
         self._last_ticks = counts.copy()
         self._last_stamp_sec = float(stamp_sec)

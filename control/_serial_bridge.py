@@ -225,7 +225,7 @@ class SerialMotorBridge(Node):
             return
         ticks = np.asarray(message.ticks, dtype=np.int64)
         if self._last_ticks is not None:
-            delta = tick_delta(ticks, self._last_ticks) * (2.0 * math.pi / self.ticks_per_revolution)
+            delta = np.asarray(tick_delta(ticks, self._last_ticks), dtype=np.float64) * (2.0 * math.pi / self.ticks_per_revolution)
             dt = (message.timestamp_us - self._last_tick_us) * 1e-6
             self.wheel_positions_rad = self.wheel_positions_rad + delta
             if dt > 0.0:

@@ -53,7 +53,7 @@ def configure_logging(level: str, stream: TextIO | None = None) -> logging.Handl
     logger = logging.getLogger("aiorobot")
     for old in [h for h in logger.handlers if getattr(h, "_aiorobot_cli", False)]:
         logger.removeHandler(old)
-    handler._aiorobot_cli = True  # type: ignore[attr-defined]
+    setattr(handler, "_aiorobot_cli", True)  # marks the handler this CLI installed  # noqa: B010
     logger.addHandler(handler)
     logger.setLevel(parse_level(level))
     logger.propagate = False

@@ -118,7 +118,7 @@ class ApproximateTimeSynchronizer(_Synchronizer):
     ) -> None:
         if isinstance(slop_sec, bool) or not isinstance(slop_sec, (int, float)) or not slop_sec >= 0:
             raise ValueError(f"slop_sec: expected a number of seconds >= 0, got {slop_sec!r}")
-        policy = ApproximateTimePolicy(
+        policy: ApproximateTimePolicy[Any] = ApproximateTimePolicy(
             len(inputs), queue_size, max_interval_ns=round(slop_sec * 1e9), age_penalty=age_penalty
         )
         super().__init__(inputs, policy, allow_headerless=allow_headerless)

@@ -245,14 +245,14 @@ def _build(root: ET.Element) -> UrdfModel:
         )
     # every link must reach the root: otherwise a loop hides in a detached part
     child_parent = {j.child: j.parent for j in joints.values()}
-    for link in links:
+    for link_name in links:
         seen = set()
-        node = link
-        while node in child_parent:
-            if node in seen:
-                raise URDFError(f'the joints form a loop through link "{node}"')
-            seen.add(node)
-            node = child_parent[node]
+        current = link_name
+        while current in child_parent:
+            if current in seen:
+                raise URDFError(f'the joints form a loop through link "{current}"')
+            seen.add(current)
+            current = child_parent[current]
     return UrdfModel(name, tuple(links), joints, roots[0])
 
 
