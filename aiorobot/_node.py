@@ -22,13 +22,9 @@ from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 from ._logging import NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
-from ._parameters import (
-    OnSetCallback,
-    Parameter,
-    ParameterDescriptor,
-    ParameterStore,
-    SetParametersResult,
-)
+from ._node_graph import NodeGraphMixin
+from ._node_parameters import NodeParametersMixin
+from ._parameters import ParameterStore
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile
 from ._services import Client, Service
@@ -45,7 +41,7 @@ M = TypeVar("M")
 R = TypeVar("R")
 
 
-class Node:
+class Node(NodeParametersMixin, NodeGraphMixin):
     """A ROS 2 style node, asyncio-native.
 
     Parameters
@@ -333,67 +329,6 @@ class Node:
     def timers(self) -> tuple[Timer, ...]:
         return tuple(self._timers)
 
-    # -- parameters ---------------------------------------------------------------------
-
-    def declare_parameter(
-        self,
-        name: str,
-        default: Any = None,
-        *,
-        description: str = "",
-        read_only: bool = False,
-        range: Iterable[float] | None = None,
-    ) -> Parameter:
-        """Declare a parameter; an override given to the node replaces ``default``.
-
-        Raises ``InvalidParameterValueError`` when the override has the wrong type
-        or lies outside ``range`` (``(from, to)`` or ``(from, to, step)``).
-        """
-        return self._parameters.declare(
-            name,
-            default,
-            description=description,
-            read_only=read_only,
-            range=tuple(range) if range is not None else None,
-        )
-
-    def declare_parameters(self, values: Mapping[str, Any]) -> list[Parameter]:
-        return [self.declare_parameter(name, value) for name, value in values.items()]
-
-    def has_parameter(self, name: str) -> bool:
-        return self._parameters.has(name)
-
-    def get_parameter(self, name: str) -> Parameter:
-        return self._parameters.get(name)
-
-    def get_parameters(self, names: Iterable[str]) -> list[Parameter]:
-        return [self._parameters.get(n) for n in names]
-
-    def describe_parameter(self, name: str) -> ParameterDescriptor:
-        return self._parameters.describe(name)
-
-    def list_parameters(self) -> list[str]:
-        return self._parameters.names()
-
-    def set_parameters(self, parameters: Iterable[Parameter]) -> list[SetParametersResult]:
-        """Set each parameter; one result per parameter saying whether and why not."""
-        return self._parameters.set(parameters)
-
-    async def set_parameters_async(self, parameters: Iterable[Parameter]) -> list[SetParametersResult]:
-        """As :meth:`set_parameters`, awaiting ``async def`` on-set callbacks."""
-        return await self._parameters.set_async(parameters)
-
-    def add_on_set_parameters_callback(self, callback: OnSetCallback) -> OnSetCallback:
-        """``callback(params) -> SetParametersResult`` vets every change before it applies."""
-        return self._parameters.add_callback(callback)
-
-    def remove_on_set_parameters_callback(self, callback: OnSetCallback) -> None:
-        self._parameters.remove_callback(callback)
-
-    def unclaimed_parameter_overrides(self) -> list[str]:
-        """Overrides given to the node for parameters it never declared."""
-        return self._parameters.unclaimed_overrides()
-
     # -- logging and time -----------------------------------------------------------------
 
     def get_logger(self) -> NodeLogger:
@@ -416,17 +351,6 @@ class Node:
         """Run ``fn`` in the runtime's thread pool: for kernels that release the GIL (OpenCV, Numba)."""
         pool = self.runtime._thread_pool()
         return await asyncio.get_running_loop().run_in_executor(pool, functools.partial(fn, *args, **kwargs))
-
-    # -- graph queries --------------------------------------------------------------------
-
-    def count_publishers(self, topic: str) -> int:
-        return len(self.runtime.graph.publishers_of(self.resolve_topic_name(topic)))
-
-    def count_subscribers(self, topic: str) -> int:
-        return len(self.runtime.graph.subscriptions_of(self.resolve_topic_name(topic)))
-
-    def get_topic_names_and_types(self) -> list[tuple[str, list[str]]]:
-        return [(t.name, list(t.types)) for t in self.runtime.graph.topics]
 
     # -- runtime plumbing (private) ----------------------------------------------------------
 
