@@ -84,41 +84,41 @@ class Bus:
             self._report(topic, pub, sub, reason)
 
     def add_publisher(self, pub: Publisher) -> None:
-        with self._lock:
-            topic = self._topics.setdefault(pub.topic_name, _Topic(pub.topic_name))
-            bad = [(pub, s, r) for s in topic.subscriptions if (r := self._why_not(pub, s))]
-            self._check_strict(bad, topic)
-            topic.publishers.append(pub)
-            for p, s, reason in bad:
-                topic.incompatible.append((p, s, reason))
-                self._report(topic, p, s, reason)
-            self._retarget(topic, pub)
-            if pub._history is not None:
-                for sub in topic.subscriptions:
-                    if sub not in pub._subs:
-                        continue
-                    if sub.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL:
-                        self._replay(pub, sub)
-        self._notify_added(pub)
+        self._add(pub)
 
     def add_subscription(self, sub: Sub) -> None:
+        self._add(sub)
+
+    def _add(self, endpoint: Publisher | Sub) -> None:
+        """Register an endpoint: match it against the other side, warn or refuse what does not
+        connect, and replay transient-local history to subscriptions it newly connects."""
         with self._lock:
-            topic = self._topics.setdefault(sub.topic_name, _Topic(sub.topic_name))
-            bad = [(p, sub, r) for p in topic.publishers if (r := self._why_not(p, sub))]
+            topic = self._topics.setdefault(endpoint.topic_name, _Topic(endpoint.topic_name))
+            if isinstance(endpoint, Publisher):
+                pairs = [(endpoint, s) for s in topic.subscriptions]
+            else:
+                pairs = [(p, endpoint) for p in topic.publishers]
+            bad = [(p, s, r) for p, s in pairs if (r := self._why_not(p, s))]
             self._check_strict(bad, topic)
-            topic.subscriptions.append(sub)
+            if isinstance(endpoint, Publisher):
+                topic.publishers.append(endpoint)
+                retarget = [endpoint]
+            else:
+                topic.subscriptions.append(endpoint)
+                retarget = topic.publishers
             for p, s, reason in bad:
                 topic.incompatible.append((p, s, reason))
                 self._report(topic, p, s, reason)
-            for pub in topic.publishers:
+            for pub in retarget:
                 self._retarget(topic, pub)
+            for p, s in pairs:
                 if (
-                    sub in pub._subs
-                    and pub._history is not None
-                    and sub.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL
+                    p._history is not None
+                    and s in p._subs
+                    and s.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL
                 ):
-                    self._replay(pub, sub)
-        self._notify_added(sub)
+                    self._replay(p, s)
+        self._notify_added(endpoint)
 
     def remove(self, endpoint: Endpoint) -> None:
         with self._lock:
