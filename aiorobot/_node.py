@@ -343,9 +343,30 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     # -- work elsewhere -------------------------------------------------------------------
 
     async def offload(self, fn: Callable[..., R], *args: Any, **kwargs: Any) -> R:
-        """Run a picklable ``fn(*args, **kwargs)`` in the runtime's process pool."""
+        """Run a picklable ``fn(*args, **kwargs)`` in the runtime's process pool.
+
+        Large numpy arrays in the arguments and the result (images, clouds) cross in
+        shared memory, not through the pool's pipe. A script that offloads needs the
+        ``if __name__ == "__main__":`` guard: the pool starts workers with forkserver.
+        """
+        from . import _offload
+
         pool = self.runtime._process_pool()
-        return await asyncio.get_running_loop().run_in_executor(pool, functools.partial(fn, *args, **kwargs))
+        payload, segments = _offload.dumps((fn, args, kwargs))
+        try:
+            future = pool.submit(_offload.run_call, payload)
+        except BaseException:
+            _offload.release(segments)
+            raise
+        try:
+            data = await asyncio.wrap_future(future)
+        except asyncio.CancelledError:
+            future.add_done_callback(_discard_result)  # still frees its result's segments
+            raise
+        finally:
+            _offload.release(segments)  # what the worker did not receive (a failed call)
+        result: R = _offload.loads(data)
+        return result
 
     async def run_in_thread(self, fn: Callable[..., R], *args: Any, **kwargs: Any) -> R:
         """Run ``fn`` in the runtime's thread pool: for kernels that release the GIL (OpenCV, Numba)."""
@@ -499,6 +520,14 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         except Exception:
             self._logger.error(f"callback of {_describe(entity)} in {self._fqn} raised", exc_info=True)
             return None
+
+
+def _discard_result(future: Any) -> None:
+    """Unpickle and drop the result of an offloaded call nobody awaits, freeing its shared memory."""
+    if not future.cancelled() and future.exception() is None:
+        from . import _offload
+
+        _offload.loads(future.result())
 
 
 def _describe(entity: Any) -> str:
