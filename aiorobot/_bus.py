@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from ._errors import QoSIncompatibleError
+from ._mutation import PublishGuard
 from ._pubsub import Endpoint, Publisher, Subscription, Tap
 from ._qos import DurabilityPolicy, incompatibility
 from ._services import ServiceRegistry
@@ -51,8 +52,9 @@ class _Topic:
 class Bus:
     """Connects the publishers and subscriptions of one runtime."""
 
-    def __init__(self, *, strict_qos: bool = False) -> None:
+    def __init__(self, *, strict_qos: bool = False, debug_messages: bool = False) -> None:
         self.strict_qos = strict_qos
+        self.debug_messages = debug_messages
         self._lock = threading.RLock()
         self._topics: dict[str, _Topic] = {}
         self.services = ServiceRegistry()
@@ -100,6 +102,11 @@ class Bus:
                 pairs = [(p, endpoint) for p in topic.publishers]
             bad = [(p, s, r) for p, s in pairs if (r := self._why_not(p, s))]
             self._check_strict(bad, topic)
+            if self.debug_messages:
+                if isinstance(endpoint, Publisher):
+                    endpoint._guard = PublishGuard()
+                elif isinstance(endpoint, Subscription):
+                    endpoint._debug = True
             if isinstance(endpoint, Publisher):
                 topic.publishers.append(endpoint)
                 retarget = [endpoint]

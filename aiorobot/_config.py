@@ -54,6 +54,7 @@ _RUNTIME_KEYS = (
     "strict_qos",
     "log_level",
     "priority_realtime",
+    "debug_messages",
 )
 _NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level")
 _RECORD_KEYS = ("path",)
@@ -104,6 +105,7 @@ class RuntimeConfig:
     strict_qos: bool = False
     log_level: str = "info"
     priority_realtime: bool = False
+    debug_messages: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -239,7 +241,9 @@ def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
     log_level = checker.choice(table, "runtime", "log_level", LOG_LEVELS, "info")
     realtime = table.get("priority_realtime", False)
     checker.check_type(realtime, "runtime.priority_realtime", bool, "true or false")
-    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level, realtime)
+    debug_messages = table.get("debug_messages", False)
+    checker.check_type(debug_messages, "runtime.debug_messages", bool, "true or false")
+    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages)
 
 
 def _parse_nodes(checker: _Checker, data: Mapping[str, Any]) -> tuple[NodeConfig, ...]:

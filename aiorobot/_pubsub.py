@@ -10,11 +10,13 @@ another loop arrive through ``call_soon_threadsafe``.
 from __future__ import annotations
 
 import asyncio
+import inspect
 import threading
 from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
+from ._mutation import PublishGuard, digest
 from ._qos import DurabilityPolicy, QoSProfile
 
 if TYPE_CHECKING:
@@ -74,6 +76,7 @@ class Publisher(Endpoint, Generic[M]):
         self._other_loops: tuple[tuple[asyncio.AbstractEventLoop, tuple[Subscription, ...]], ...] = ()
         self._taps: tuple[Tap, ...] = ()
         self._thread_id: int | None = None
+        self._guard: PublishGuard | None = None  # Runtime(debug_messages=True)
         self.published = 0
 
     def __repr__(self) -> str:
@@ -116,6 +119,12 @@ class Publisher(Endpoint, Generic[M]):
         if self.destroyed:
             raise RuntimeError(f"{self!r} was destroyed")
         self.published += 1
+        if self._guard is not None and not self._guard.check(msg):
+            self.node.get_logger().error(
+                f"debug_messages: a message published on {self.topic_name} was changed after publish; "
+                "subscribers receive the very object, so publish a new message each time",
+                throttle_duration_sec=1.0,
+            )
         if self._history is not None:
             self._history.append(msg)
         if threading.get_ident() == self._thread_id:
@@ -193,6 +202,7 @@ class Subscription(Endpoint, Generic[M]):
         self._waiter: asyncio.Future[None] | None = None
         self._task: asyncio.Task[None] | None = None
         self._busy = 0
+        self._debug = False  # Runtime(debug_messages=True): check callbacks leave messages as they found them
         self.received = 0
         self.dropped = 0
 
@@ -247,6 +257,8 @@ class Subscription(Endpoint, Generic[M]):
         group = self.callback_group
         callback = self.callback
         assert callback is not None
+        if self._debug:
+            callback = self._checked(callback)
         handled = 0
         while True:
             if not queue:
@@ -271,6 +283,24 @@ class Subscription(Endpoint, Generic[M]):
 
     def _callback_done(self, _task: asyncio.Task[None]) -> None:
         self._busy -= 1
+
+    def _checked(self, callback: Callable[[Any], Any]) -> Callable[[Any], Any]:
+        """``callback``, reporting when it changes the (shared) message it was given."""
+
+        async def checked(msg: Any) -> Any:
+            before = digest(msg)
+            result = callback(msg)
+            if result is not None and inspect.isawaitable(result):
+                result = await result
+            if digest(msg) != before:
+                self.node.get_logger().error(
+                    f"debug_messages: the callback of subscription {self.topic_name} changed the message it "
+                    "received; other subscribers share that object, so copy it before changing it",
+                    throttle_duration_sec=1.0,
+                )
+            return result
+
+        return checked
 
     def destroy(self) -> None:
         self.node.destroy_subscription(self)

@@ -65,6 +65,10 @@ class Runtime:
 
     handle_signals
         While ``spin`` runs, SIGINT and SIGTERM shut the runtime down cleanly.
+    debug_messages
+        Check the zero-copy contract: log an error when a publisher changes a message after
+        publishing it, or a subscription callback changes the message it received
+        (development aid; it pickles every message).
     """
 
     def __init__(
@@ -79,6 +83,7 @@ class Runtime:
         thread_workers: int | None = None,
         priority_realtime: bool = False,
         handle_signals: bool = True,
+        debug_messages: bool = False,
     ) -> None:
         self._config = config
         if config is not None:
@@ -91,6 +96,7 @@ class Runtime:
             use_sim_time = cfg.runtime.use_sim_time
             strict_qos = cfg.runtime.strict_qos
             priority_realtime = cfg.runtime.priority_realtime
+            debug_messages = cfg.runtime.debug_messages
         if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
             raise ValueError(f"domain_id: expected an int in 0..232, found {domain_id!r}")
         self.transport = (
@@ -99,7 +105,7 @@ class Runtime:
         self.domain_id = domain_id
         self.use_sim_time = use_sim_time
         self.clock = Clock(ClockType.ROS_TIME, use_sim_time=use_sim_time)
-        self._bus = Bus(strict_qos=strict_qos)
+        self._bus = Bus(strict_qos=strict_qos, debug_messages=debug_messages)
         self._bus.transport = self.transport
         self._nodes: list[Node] = []
         self._pending: list[tuple[Node, str]] = []

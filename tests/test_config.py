@@ -233,6 +233,9 @@ def test_priority_realtime_reaches_the_runtime(tmp_path):
     from aiorobot import Runtime
 
     path = tmp_path / "rt.toml"
-    path.write_text('[runtime]\npriority_realtime = true\n\n[[nodes]]\nuse = "aiorobot.examples.sensor:ImuPublisher"\n')
+    path.write_text(
+        '[runtime]\npriority_realtime = true\ndebug_messages = true\n\n[[nodes]]\nuse = "aiorobot.examples.sensor:ImuPublisher"\n'
+    )
     assert load_config(path).runtime.priority_realtime is True
-    assert Runtime(config=path)._priority_realtime is True
+    runtime = Runtime(config=path)
+    assert runtime._priority_realtime is True and runtime._bus.debug_messages is True

@@ -104,6 +104,7 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
             use_sim_time=runtime_config.use_sim_time,
             strict_qos=runtime_config.strict_qos,
             priority_realtime=runtime_config.priority_realtime,
+            debug_messages=runtime_config.debug_messages,
             handle_signals=False,  # ours stay installed until the runtime has fully shut down
         ) as rt:
             for signum in signals:

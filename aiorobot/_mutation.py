@@ -1,0 +1,42 @@
+"""``Runtime(debug_messages=True)``: checks of the zero-copy contract.
+
+In-process delivery hands every subscriber the very object that was published,
+so neither a publisher (after ``publish``) nor a subscriber may change it. With
+debug checks on, a publisher re-checks its last few messages each time it
+publishes, and a subscription checks that its callback left the message as it
+found it; a change is logged as an error naming the topic and the node. The
+checks pickle messages, so they are for development, not production.
+"""
+
+from __future__ import annotations
+
+import pickle
+from collections import deque
+from typing import Any
+
+__all__ = ["PublishGuard", "digest"]
+
+#: How many recent messages a publisher keeps checking.
+RECENT = 8
+
+
+def digest(msg: Any) -> bytes:
+    """A byte image of ``msg`` (numpy array contents included)."""
+    return pickle.dumps(msg, protocol=pickle.HIGHEST_PROTOCOL)
+
+
+class PublishGuard:
+    """Remembers a publisher's recent messages and reports those changed after ``publish``."""
+
+    def __init__(self) -> None:
+        self._recent: deque[tuple[Any, bytes]] = deque(maxlen=RECENT)
+
+    def check(self, msg: Any) -> bool:
+        """Record ``msg``; return False when one of the recent messages has changed since it was published."""
+        intact = True
+        for entry in list(self._recent):
+            if digest(entry[0]) != entry[1]:
+                intact = False
+                self._recent.remove(entry)
+        self._recent.append((msg, digest(msg)))
+        return intact
