@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["print_report", "render_report"]
+__all__ = ["figure_table", "print_report", "render_report"]
 
 
 def _f(value: Any, digits: int = 1) -> str:
@@ -157,6 +157,21 @@ def _tf_table(part: dict[str, Any]) -> Any:
     return table
 
 
+def figure_table(title: str, columns: tuple[str, ...], rows: list[tuple[Any, ...]], *, caption: str | None = None) -> Any:
+    """A table for a part's figures: the first column left-aligned, numbers formatted with ``_f``.
+
+    What domain parts (sim, fusion, perception, ...) build their ``table(part)`` from.
+    """
+    from rich.table import Table
+
+    table = Table(title=title, title_justify="left", caption=caption)
+    for i, col in enumerate(columns):
+        table.add_column(col, justify="left" if i == 0 else "right")
+    for row in rows:
+        table.add_row(*(cell if isinstance(cell, str) else _f(cell, 2) for cell in row))
+    return table
+
+
 _TABLES = {"seed": _seed_table, "timer": _timer_table, "latency": _latency_table, "cpu": _cpu_table, "tf": _tf_table}
 
 
@@ -183,8 +198,23 @@ def render_report(doc: dict[str, Any]) -> list[Any]:
         if "error" in part:
             out.append(Text(f"{name}: {part['error']}"))
             continue
-        out.append(_TABLES[name](part))
+        out.append(_table_for(name)(part))
     return out
+
+
+def _table_for(name: str) -> Any:
+    """The table builder of part ``name``: a built-in one, or the part module's own ``table(part)``.
+
+    Parts added by domain packages (sim, fusion, perception, ...) keep their table beside their
+    figures: the module named in ``PARTS`` provides ``table(part: dict) -> rich.table.Table``.
+    """
+    if name in _TABLES:
+        return _TABLES[name]
+    import importlib
+
+    from ._runner import PARTS
+
+    return importlib.import_module(PARTS[name]).table
 
 
 def print_report(doc: dict[str, Any], console: Any = None) -> None:

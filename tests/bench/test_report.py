@@ -55,3 +55,20 @@ def test_report_names_a_model_or_part_that_could_not_run() -> None:
 
 def test_failures_lists_failed_parts_and_models() -> None:
     assert _failures(_doc()) == ["seed/aiorobot/cpu", "tf"]
+
+
+def test_a_part_outside_the_builtin_ones_is_drawn_by_its_own_module(monkeypatch: Any) -> None:
+    import sys
+    import types
+
+    from aiorobot.bench import _runner
+    from aiorobot.bench._report import figure_table
+
+    module = types.ModuleType("_bench_part_for_test")
+    module.table = lambda part: figure_table("extra part", ("case", "value"), [(k, v) for k, v in part.items()])  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "_bench_part_for_test", module)
+    monkeypatch.setitem(_runner.PARTS, "extra", "_bench_part_for_test")
+    console = Console(width=120, record=True)
+    print_report({"meta": {}, "parts": {"extra": {"scan ms": 0.25}}}, console)
+    text = console.export_text()
+    assert "extra part" in text and "scan ms" in text and "0.25" in text
