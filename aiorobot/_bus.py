@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -59,6 +59,7 @@ class Bus:
         self._topics: dict[str, _Topic] = {}
         self.services = ServiceRegistry()
         self.transport: Transport | None = None
+        self._watchers: tuple[Callable[[Endpoint], None], ...] = ()
 
     def __repr__(self) -> str:
         return f"<Bus topics={len(self._topics)} strict_qos={self.strict_qos}>"
@@ -148,9 +149,24 @@ class Bus:
         if self.transport is not None:
             self.transport.endpoint_removed(endpoint)
 
+    def watch(self, callback: Callable[[Endpoint], None]) -> Callable[[], None]:
+        """Call ``callback(endpoint)`` for every endpoint added from now on, in the adding thread,
+        before the adding call returns (so a recorder can tap a publisher before its first message).
+        Returns the function that stops watching."""
+        with self._lock:
+            self._watchers = (*self._watchers, callback)
+
+        def unwatch() -> None:
+            with self._lock:
+                self._watchers = tuple(w for w in self._watchers if w is not callback)
+
+        return unwatch
+
     def _notify_added(self, endpoint: Endpoint) -> None:
         if self.transport is not None:
             self.transport.endpoint_added(endpoint)
+        for watcher in self._watchers:
+            watcher(endpoint)
 
     def _retarget(self, topic: _Topic, pub: Publisher) -> None:
         bad = {id(s) for p, s, _ in topic.incompatible if p is pub}
