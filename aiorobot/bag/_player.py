@@ -1,0 +1,211 @@
+"""``Player``: plays a rosbag2 directory back into a graph, paced like the recording.
+
+Messages are published in time order with the recorded spacing divided by ``rate``. With
+``clock`` the player also publishes ``/clock`` (rosgraph_msgs/Clock) carrying the playback
+time, at ``clock_hz`` between messages and exactly at each message's recorded time just
+before it is published, so nodes on sim time see ``now()`` equal to the recorded stamp.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from dataclasses import dataclass
+from typing import Any
+
+from .._node import Node
+from .._qos import QoSProfile, ReliabilityPolicy
+from ._metadata import BagError
+from ._reader import BagReader
+
+__all__ = ["Player", "PlayerStatistics", "parse_remaps"]
+
+
+def parse_remaps(remaps: list[str]) -> dict[str, str]:
+    """``["/a:=/b", ...]`` -> ``{"/a": "/b"}``; a malformed entry raises ValueError naming it."""
+    out: dict[str, str] = {}
+    for item in remaps:
+        src, sep, dst = item.partition(":=")
+        if not sep or not src or not dst:
+            raise ValueError(f"remap: expected FROM:=TO, found {item!r}")
+        out[src] = dst
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class PlayerStatistics:
+    """What a player has done: messages published, skipped (unknown type), loops completed."""
+
+    published: int
+    skipped: int
+    loops: int
+    paused: bool
+    rate: float
+
+
+class Player(Node):
+    """A node that plays a rosbag2 directory.
+
+    Parameters: ``path`` (the bag directory), ``rate`` (playback speed, > 0), ``clock``
+    (publish ``/clock``), ``clock_hz`` (its rate between messages, default 40 as ``ros2 bag
+    play --clock``), ``loop``, ``start_offset`` (seconds into the bag), ``topics`` (only these),
+    ``remap`` (``["/from:=/to", ...]``), ``start_paused``.
+    """
+
+    def __init__(
+        self,
+        node_name: str = "player",
+        *,
+        path: str = "",
+        rate: float = 1.0,
+        clock: bool = False,
+        clock_hz: float = 40.0,
+        loop: bool = False,
+        start_offset: float = 0.0,
+        topics: list[str] | None = None,
+        remap: list[str] | None = None,
+        start_paused: bool = False,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(node_name, **kwargs)
+        self._published = 0
+        self._skipped = 0
+        self._loops = 0
+        self.path = str(self.declare_parameter("path", path).value)
+        self.rate = float(self.declare_parameter("rate", float(rate)).value)
+        self.publish_clock = bool(self.declare_parameter("clock", clock).value)
+        self.clock_hz = float(self.declare_parameter("clock_hz", float(clock_hz)).value)
+        self.loop = bool(self.declare_parameter("loop", loop).value)
+        self.start_offset = float(self.declare_parameter("start_offset", float(start_offset)).value)
+        self.only = [t for t in self.declare_parameter("topics", list(topics or [""])).value if t]
+        self.remaps = parse_remaps([r for r in self.declare_parameter("remap", list(remap or [""])).value if r])
+        if not self.path:
+            raise ValueError(f"player {self.get_name()}: parameter 'path' (the bag directory) is required")
+        if not self.rate > 0:
+            raise ValueError(f"player {self.get_name()}: rate must be > 0, found {self.rate!r}")
+        if not self.clock_hz > 0:
+            raise ValueError(f"player {self.get_name()}: clock_hz must be > 0, found {self.clock_hz!r}")
+        if self.start_offset < 0:
+            raise ValueError(f"player {self.get_name()}: start_offset must be >= 0, found {self.start_offset!r}")
+        self.reader = BagReader(self.path)  # a bad bag fails here, before anything starts
+        known = {t.name for t in self.reader.topics}
+        missing = [t for t in self.only if t not in known]
+        if missing:
+            raise BagError(f"{self.path}: no topic {missing[0]} in the bag (topics: {', '.join(sorted(known))})")
+        self._topic_pubs: dict[str, Any] = {}
+        self._types: dict[str, Any] = {}
+        for info in self.reader.topics:
+            if self.only and info.name not in self.only:
+                continue
+            msg_type = self.reader.message_type(info.name)
+            if msg_type is None:
+                self.get_logger().warning(f"{info.name}: type {info.type} is unknown; its {info.message_count} messages are skipped")
+                continue
+            self._types[info.name] = msg_type
+            self._topic_pubs[info.name] = self.create_publisher(msg_type, self.remaps.get(info.name, info.name), info.qos)
+        self._clock_pub: Any = None
+        if self.publish_clock:
+            from aiorobot.msgs.rosgraph_msgs import Clock
+
+            self._clock_pub = self.create_publisher(Clock, "/clock", QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1))
+        self._resume = asyncio.Event()
+        if not start_paused:
+            self._resume.set()
+        self._done = asyncio.Event()
+        self._task: asyncio.Task[None] | None = None
+
+    def __repr__(self) -> str:
+        return f"<Player {self.path} rate={self.rate:g} published={self._published}>"
+
+    def statistics(self) -> PlayerStatistics:
+        return PlayerStatistics(self._published, self._skipped, self._loops, not self._resume.is_set(), self.rate)
+
+    # -- control ------------------------------------------------------------------------
+
+    def pause(self) -> None:
+        self._resume.clear()
+
+    def resume(self) -> None:
+        self._resume.set()
+
+    def toggle_pause(self) -> bool:
+        """Pause if playing, resume if paused; returns True when now paused."""
+        if self._resume.is_set():
+            self.pause()
+            return True
+        self.resume()
+        return False
+
+    def set_rate(self, rate: float) -> None:
+        if not rate > 0:
+            raise ValueError(f"rate must be > 0, found {rate!r}")
+        self.rate = float(rate)
+
+    @property
+    def done(self) -> bool:
+        return self._done.is_set()
+
+    async def wait_for_completion(self, timeout_sec: float | None = None) -> bool:
+        """Wait until every message was played (never, with ``loop``); False on timeout."""
+        try:
+            await asyncio.wait_for(self._done.wait(), timeout_sec)
+        except TimeoutError:
+            return False
+        return True
+
+    # -- playing -------------------------------------------------------------------------
+
+    async def on_start(self) -> None:
+        self._task = self._create_task(self._play(), name=f"aiorobot-player {self.path}")
+
+    async def on_shutdown(self) -> None:
+        if self._task is not None:
+            self._task.cancel()
+        self.reader.close()
+
+    async def _play(self) -> None:
+        from aiorobot.msgs import deserialize
+
+        start = self.reader.start_ns + int(self.start_offset * 1e9)
+        try:
+            while True:
+                bag_t0 = start
+                wall_t0 = time.monotonic()
+                paused_at: float | None = None
+                last_clock = 0.0
+                for topic, t_ns, data in self.reader.messages(list(self._types), start_ns=start):
+                    while True:  # pace: wait for the message's time, publishing /clock meanwhile
+                        if not self._resume.is_set():
+                            paused_at = time.monotonic()
+                            await self._resume.wait()
+                            wall_t0 += time.monotonic() - paused_at
+                        now = time.monotonic()
+                        due = wall_t0 + (t_ns - bag_t0) / 1e9 / self.rate
+                        if now >= due:
+                            break
+                        if self._clock_pub is not None and now - last_clock >= 1.0 / self.clock_hz:
+                            self._publish_clock(bag_t0 + int((now - wall_t0) * self.rate * 1e9))
+                            last_clock = now
+                        step = due - now if self._clock_pub is None else min(due - now, 1.0 / self.clock_hz)
+                        await asyncio.sleep(step)
+                    if self._clock_pub is not None:
+                        self._publish_clock(t_ns)
+                    try:
+                        msg = deserialize(data, self._types[topic])
+                    except Exception as err:  # a damaged record: skip it, say so, keep playing
+                        self._skipped += 1
+                        self.get_logger().warning(f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0)
+                        continue
+                    self._topic_pubs[topic].publish(msg)
+                    self._published += 1
+                self._loops += 1
+                if not self.loop:
+                    break
+        finally:
+            self._done.set()
+
+    def _publish_clock(self, t_ns: int) -> None:
+        from aiorobot.msgs.builtin_interfaces import Time as TimeMsg
+        from aiorobot.msgs.rosgraph_msgs import Clock
+
+        self._clock_pub.publish(Clock(clock=TimeMsg(sec=t_ns // 1_000_000_000, nanosec=t_ns % 1_000_000_000)))

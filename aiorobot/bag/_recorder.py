@@ -1,0 +1,229 @@
+"""``Recorder``: records topics of a running graph into a rosbag2 (MCAP) directory, losing nothing.
+
+Each recorded topic gets a *tap* on the runtime's bus: a subscription whose callback runs in
+the publishing thread, so the recorder sees every message in publish order without a queue
+that could overflow. The tap serialises the message there (so a publisher that reuses its
+message object afterwards cannot change what was recorded) and hands the bytes to a writer
+thread, which appends them to the bag. With ``all_topics`` a bus watcher taps every topic the
+moment its first publisher appears, before that publisher can publish.
+"""
+
+from __future__ import annotations
+
+import datetime
+import queue
+import re
+import threading
+from pathlib import Path
+from dataclasses import dataclass
+from typing import Any
+
+from .._node import Node
+from .._pubsub import Endpoint, Publisher, Tap
+from .._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ._metadata import BagError
+from ._writer import CHUNK_SIZE, BagWriter
+
+__all__ = ["Recorder", "RecorderStatistics", "default_bag_name"]
+
+_STOP = object()
+
+
+def default_bag_name() -> str:
+    """``rosbag2_YYYY_MM_DD-HH_MM_SS``, the directory name ``ros2 bag record`` picks."""
+    return datetime.datetime.now().strftime("rosbag2_%Y_%m_%d-%H_%M_%S")
+
+
+@dataclass(frozen=True, slots=True)
+class RecorderStatistics:
+    """What a recorder has done so far."""
+
+    topics: int
+    messages: int
+    bytes: int
+    queued: int
+
+
+class Recorder(Node):
+    """A node that records topics into a rosbag2 directory with MCAP storage.
+
+    Parameters (also from a config's ``parameters``): ``path`` (output directory; default
+    ``rosbag2_<date>-<time>``), ``topics`` (list of topic names), ``all`` (record every topic;
+    the default when ``topics`` is empty), ``exclude`` (a regular expression of topics not to
+    record with ``all``), ``max_bag_size`` (bytes per file, 0 = no split),
+    ``max_bag_duration`` (seconds per file, 0 = no split), ``max_cache_size`` (bytes of messages
+    held before a chunk goes to the file: what a crash can lose; default 256 KiB).
+    """
+
+    def __init__(
+        self,
+        node_name: str = "recorder",
+        *,
+        path: str | None = None,
+        topics: list[str] | None = None,
+        all_topics: bool | None = None,
+        exclude: str = "",
+        max_bag_size: int = 0,
+        max_bag_duration: float = 0.0,
+        max_cache_size: int = 0,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(node_name, **kwargs)
+        self.path = str(self.declare_parameter("path", path or default_bag_name()).value)
+        wanted = list(self.declare_parameter("topics", list(topics or [""])).value or [])
+        self.topics = [t for t in wanted if t]
+        self.all_topics = bool(self.declare_parameter("all", not self.topics if all_topics is None else all_topics).value)
+        pattern = str(self.declare_parameter("exclude", exclude).value)
+        self._exclude = re.compile(pattern) if pattern else None
+        self._max_size = int(self.declare_parameter("max_bag_size", int(max_bag_size)).value)
+        self._max_duration = float(self.declare_parameter("max_bag_duration", float(max_bag_duration)).value)
+        self._cache = int(self.declare_parameter("max_cache_size", int(max_cache_size)).value)
+        if self._max_size < 0 or self._max_duration < 0 or self._cache < 0:
+            raise ValueError(
+                f"recorder {self.get_name()}: max_bag_size, max_bag_duration and max_cache_size must be >= 0"
+            )
+        if Path(self.path).exists():
+            raise BagError(f"{self.path}: exists already; choose another output directory or remove it")
+        self._taps: dict[str, Tap] = {}
+        self._lock = threading.Lock()
+        self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self._writer: BagWriter | None = None
+        self._thread: threading.Thread | None = None
+        self._unwatch: Any = None
+        self._error: BaseException | None = None
+        self._bytes = 0
+        self._count = 0
+
+    def __repr__(self) -> str:
+        return f"<Recorder {self.path} topics={len(self._taps)} messages={self._count}>"
+
+    def statistics(self) -> RecorderStatistics:
+        return RecorderStatistics(len(self._taps), self._count, self._bytes, self._queue.qsize())
+
+    @property
+    def recorded_topics(self) -> list[str]:
+        return sorted(self._taps)
+
+    # -- lifecycle --------------------------------------------------------------------
+
+    def _bind(self, runtime: Any, *args: Any, **kwargs: Any) -> None:
+        # Attach when added to the runtime, synchronously, not in on_start: a publisher added
+        # right after the recorder must not publish before the recorder taps it.
+        super()._bind(runtime, *args, **kwargs)
+        if self._thread is None:
+            self._attach()
+
+    def _attach(self) -> None:
+        self._writer = BagWriter(
+            self.path,
+            max_bag_size=self._max_size,
+            max_bag_duration_ns=int(self._max_duration * 1e9),
+            chunk_size=self._cache or CHUNK_SIZE,
+        )
+        self._thread = threading.Thread(target=self._write_loop, name=f"aiorobot-recorder {self.path}", daemon=True)
+        self._thread.start()
+        bus = self.runtime._bus
+        if self.all_topics:
+            self._unwatch = bus.watch(self._on_endpoint)
+            for topic in bus.snapshot():
+                for pub in topic.publishers:
+                    self._on_endpoint(pub)
+        for name in self.topics:
+            self._tap_requested(name)
+        self.get_logger().info(
+            f"recording {'all topics' if self.all_topics else ', '.join(self.topics)} to {self.path}"
+        )
+
+    async def on_shutdown(self) -> None:
+        self.stop()
+
+    def stop(self) -> None:
+        """Stop recording: detach every tap, write what is queued, close the bag. Idempotent."""
+        if self._unwatch is not None:
+            self._unwatch()
+            self._unwatch = None
+        if self._runtime is not None:
+            with self._lock:
+                taps, self._taps = list(self._taps.values()), {}
+            for tap in taps:
+                self._runtime._bus.remove(tap)
+        if self._thread is not None:
+            self._queue.put(_STOP)
+            self._thread.join()
+            self._thread = None
+        if self._error is not None:
+            raise BagError(f"recorder {self.get_name()}: writing {self.path} failed: {self._error}")
+
+    # -- taps -------------------------------------------------------------------------
+
+    def _on_endpoint(self, endpoint: Endpoint) -> None:
+        if not isinstance(endpoint, Publisher) or endpoint.topic_name in self._taps:
+            return
+        if self._exclude is not None and self._exclude.search(endpoint.topic_name):
+            return
+        self._add_tap(endpoint.topic_name, endpoint.msg_type, endpoint.qos)
+
+    def _tap_requested(self, name: str) -> None:
+        """Tap ``name`` now if it has a publisher, else as soon as one appears."""
+        name = self.resolve_topic_name(name)
+        for topic in self.runtime._bus.snapshot():
+            if topic.name == name and topic.publishers:
+                pub = topic.publishers[0]
+                self._add_tap(name, pub.msg_type, pub.qos)
+                return
+        unwatch = None
+
+        def later(endpoint: Endpoint) -> None:
+            if isinstance(endpoint, Publisher) and endpoint.topic_name == name:
+                self._add_tap(name, endpoint.msg_type, endpoint.qos)
+                if unwatch is not None:
+                    unwatch()
+
+        unwatch = self.runtime._bus.watch(later)
+
+    def _add_tap(self, name: str, msg_type: Any, offered: QoSProfile) -> None:
+        from aiorobot.msgs import serialize
+
+        with self._lock:
+            if name in self._taps or self._thread is None:
+                return
+            # Best effort connects to every publisher; transient local only where the publisher
+            # keeps history, so latched topics (/tf_static, /map) are recorded from their start.
+            durability = offered.durability
+            qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, durability=durability, depth=max(offered.depth, 1))
+            type_name = str(msg_type.__msgtype__)
+            self._queue.put(("topic", name, type_name, offered))
+            clock = self.runtime.clock
+            put = self._queue.put
+
+            def record(msg: Any) -> None:
+                put((name, clock.now().nanoseconds, serialize(msg)))
+
+            tap = Tap(msg_type, name, qos, record, owner=self.get_fully_qualified_name())
+            self._taps[name] = tap
+        self.runtime._bus.add_subscription(tap)
+        if durability is DurabilityPolicy.TRANSIENT_LOCAL:
+            self.get_logger().debug(f"recording {name} (transient local)")
+
+    # -- writer thread ------------------------------------------------------------------
+
+    def _write_loop(self) -> None:
+        writer = self._writer
+        assert writer is not None
+        try:
+            while True:
+                item = self._queue.get()
+                if item is _STOP:
+                    break
+                if item[0] == "topic":
+                    _, name, type_name, qos = item
+                    writer.add_topic(name, type_name, qos)
+                    continue
+                topic, time_ns, data = item
+                writer.write(topic, time_ns, data)
+                self._count += 1
+                self._bytes += len(data)
+        except BaseException as err:  # keep the error for stop(); drain so publishers never block
+            self._error = err
+        finally:
+            writer.close()
