@@ -43,6 +43,8 @@ class BagReader:
             self._reader.open()
         except ReaderError as err:
             raise BagError(f"{self.path}: cannot read the bag ({err}); if a recording was interrupted, run `aiorobot bag reindex {self.path}`") from None
+        self._meta = _metadata_of(self.path)
+        self._count = int(self._reader.message_count)
         self._types: dict[str, Any] = {}
         self.topics: list[TopicInfo] = []
         for name, info in self._reader.topics.items():
@@ -71,7 +73,7 @@ class BagReader:
 
     @property
     def message_count(self) -> int:
-        return int(self._reader.message_count)
+        return self._count
 
     @property
     def start_ns(self) -> int:
@@ -79,7 +81,7 @@ class BagReader:
 
     @property
     def end_ns(self) -> int:
-        return int(self._reader.end_time) if self.message_count else 0
+        return int(self._reader.end_time) - 1 if self.message_count else 0  # rosbags' end is exclusive
 
     @property
     def duration_ns(self) -> int:
@@ -87,11 +89,11 @@ class BagReader:
 
     @property
     def storage(self) -> str:
-        return str(self._reader.metadata.get("storage_identifier", "?"))
+        return str(self._meta.get("storage_identifier", "?"))
 
     @property
     def files(self) -> list[Path]:
-        return [self.path / p for p in self._reader.metadata.get("relative_file_paths", [])]
+        return [self.path / p for p in self._meta.get("relative_file_paths", [])]
 
     def messages(self, topics: Iterable[str] | None = None, *, start_ns: int | None = None) -> Iterator[tuple[str, int, bytes]]:
         """Messages of ``topics`` (all when None) at or after ``start_ns``, in time order."""
@@ -116,6 +118,13 @@ class BagReader:
         conn = next(c for c in self._reader.connections if c.topic == topic)
         msgdef = getattr(conn, "msgdef", None)
         return str(getattr(msgdef, "data", "") or "")
+
+
+def _metadata_of(path: Path) -> dict[str, Any]:
+    from ruamel.yaml import YAML
+
+    doc = YAML(typ="safe").load((path / METADATA).read_text(encoding="utf8"))
+    return dict(doc.get("rosbag2_bagfile_information", {})) if isinstance(doc, dict) else {}
 
 
 def _resolve_type(type_name: str, definition: str) -> Any:

@@ -19,6 +19,7 @@ __all__ = ["COMMANDS", "main"]
 COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config (default: the bundled example)"),
     "bench": ("aiorobot.bench._cli", "executor and transport latency benchmark"),
+    "bag": ("aiorobot.cli._bag", "record, play, inspect and repair rosbag2 (MCAP) bags"),
 }
 
 
