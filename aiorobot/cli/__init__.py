@@ -20,6 +20,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config (default: the bundled example)"),
     "bench": ("aiorobot.bench._cli", "executor and transport latency benchmark"),
     "bag": ("aiorobot.cli._bag", "record, play, inspect and repair rosbag2 (MCAP) bags"),
+    "foxglove": ("aiorobot.cli._foxglove", "serve the graph live to the Foxglove app (WebSocket)"),
+    "plot": ("aiorobot.cli._plot", "plot message fields over time from a bag or the live graph"),
 }
 
 
