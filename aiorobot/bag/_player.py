@@ -167,34 +167,37 @@ class Player(Node):
         from aiorobot.msgs import deserialize
 
         start = self.reader.start_ns + int(self.start_offset * 1e9)
+        clock_period_ns = int(1e9 / self.clock_hz)
         try:
             while True:
-                bag_t0 = start
-                wall_t0 = time.monotonic()
-                paused_at: float | None = None
-                last_clock = 0.0
+                wall_t0 = time.monotonic_ns()
+                last_clock = wall_t0 - clock_period_ns
                 for topic, t_ns, data in self.reader.messages(list(self._types), start_ns=start):
                     while True:  # pace: wait for the message's time, publishing /clock meanwhile
                         if not self._resume.is_set():
-                            paused_at = time.monotonic()
+                            paused_at = time.monotonic_ns()
                             await self._resume.wait()
-                            wall_t0 += time.monotonic() - paused_at
-                        now = time.monotonic()
-                        due = wall_t0 + (t_ns - bag_t0) / 1e9 / self.rate
+                            wall_t0 += time.monotonic_ns() - paused_at
+                        now = time.monotonic_ns()
+                        due = wall_t0 + int((t_ns - start) / self.rate)
                         if now >= due:
                             break
-                        if self._clock_pub is not None and now - last_clock >= 1.0 / self.clock_hz:
-                            self._publish_clock(bag_t0 + int((now - wall_t0) * self.rate * 1e9))
-                            last_clock = now
-                        step = due - now if self._clock_pub is None else min(due - now, 1.0 / self.clock_hz)
-                        await asyncio.sleep(step)
+                        wake = due
+                        if self._clock_pub is not None:
+                            if now - last_clock >= clock_period_ns:
+                                self._publish_clock(start + int((now - wall_t0) * self.rate))
+                                last_clock = now
+                            wake = min(due, last_clock + clock_period_ns)
+                        await self._sleep_until_ns(wake)
                     if self._clock_pub is not None:
                         self._publish_clock(t_ns)
                     try:
                         msg = deserialize(data, self._types[topic])
                     except Exception as err:  # a damaged record: skip it, say so, keep playing
                         self._skipped += 1
-                        self.get_logger().warning(f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0)
+                        self.get_logger().warning(
+                            f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0
+                        )
                         continue
                     self._topic_pubs[topic].publish(msg)
                     self._published += 1
@@ -203,6 +206,14 @@ class Player(Node):
                     break
         finally:
             self._done.set()
+
+    async def _sleep_until_ns(self, deadline_ns: int) -> None:
+        """Sleep to a monotonic deadline with the loop's precise waker (libuv timers are whole ms)."""
+        waker = self._waker
+        if waker is not None:
+            await waker.wait_until_ns(deadline_ns)
+        else:  # pragma: no cover - a player always runs bound to a runtime
+            await asyncio.sleep(max(0.0, (deadline_ns - time.monotonic_ns()) / 1e9))
 
     def _publish_clock(self, t_ns: int) -> None:
         from aiorobot.msgs.builtin_interfaces import Time as TimeMsg

@@ -25,6 +25,8 @@ class BagWriter:
 
     ``add_topic(name, type_name, qos)`` before the topic's first ``write(name, time_ns, cdr)``;
     ``close()`` finishes the file and writes ``metadata.yaml``. Use as a context manager.
+    ``compression`` is the MCAP chunk compression: ``"none"`` (rosbag2's default), ``"zstd"``
+    or ``"lz4"`` (``ros2 bag record --storage-preset-profile zstd_fast`` gives zstd chunks too).
     """
 
     def __init__(
@@ -34,6 +36,7 @@ class BagWriter:
         max_bag_size: int = 0,
         max_bag_duration_ns: int = 0,
         chunk_size: int = CHUNK_SIZE,
+        compression: str = "none",
     ) -> None:
         self.directory = Path(directory)
         if self.directory.exists():
@@ -45,6 +48,9 @@ class BagWriter:
         self.max_bag_size = max_bag_size
         self.max_bag_duration_ns = max_bag_duration_ns
         self.chunk_size = chunk_size
+        if compression not in ("none", "zstd", "lz4"):
+            raise BagError(f"compression: expected 'none', 'zstd' or 'lz4', found {compression!r}")
+        self.compression = compression
         self.topics: dict[str, TopicInfo] = {}
         self._files: list[dict[str, Any]] = []
         self._stream: IO[bytes] | None = None
@@ -131,7 +137,8 @@ class BagWriter:
 
         name = f"{self.directory.name}_{len(self._files)}.mcap"
         self._stream = open(self.directory / name, "wb")  # noqa: SIM115 - closed in _close_file
-        self._mcap = Writer(self._stream, chunk_size=self.chunk_size, compression=CompressionType.ZSTD)
+        kind = {"none": CompressionType.NONE, "zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4}[self.compression]
+        self._mcap = Writer(self._stream, chunk_size=self.chunk_size, compression=kind)
         self._mcap.start(profile="ros2", library="aiorobot")
         self._files.append({"path": name, "start_ns": 0, "duration_ns": 0, "message_count": 0, "bytes": 0})
         self._channels.clear()
