@@ -95,7 +95,7 @@ def test_duration_that_is_not_a_number_exits_2_with_one_line() -> None:
         ([], f"aiorobot: error: expected a command ({', '.join(COMMANDS)}), found none (see 'aiorobot --help')"),
         (
             ["fly"],
-            "aiorobot: error: argument COMMAND: invalid choice: 'fly' (choose from 'run', 'bench') "
+            f"aiorobot: error: argument COMMAND: invalid choice: 'fly' (choose from {', '.join(map(repr, COMMANDS))}) "
             "(see 'aiorobot --help')",
         ),
     ],
