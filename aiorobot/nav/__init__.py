@@ -1,0 +1,30 @@
+"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation (pure cores).
+
+Cores follow Nav2's definitions and parameter names (nav2_costmap_2d, NavFn/Smac 2D,
+nav2_regulated_pure_pursuit_controller, nav2_amcl) on numpy arrays, with Numba kernels where
+they loop; they are tested without a runtime.
+"""
+
+from __future__ import annotations
+
+from ._costmap import (
+    FREE_SPACE,
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    Costmap,
+    inflation_cost,
+)
+from ._planner import Plan, PlanError, plan
+
+__all__ = [
+    "FREE_SPACE",
+    "INSCRIBED_INFLATED_OBSTACLE",
+    "LETHAL_OBSTACLE",
+    "NO_INFORMATION",
+    "Costmap",
+    "Plan",
+    "PlanError",
+    "inflation_cost",
+    "plan",
+]

@@ -1,0 +1,161 @@
+"""Numba kernels of the navigation stack (cached, GIL released): grid search, ray tracing, AMCL weights."""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numba
+import numpy as np
+
+__all__ = ["astar", "likelihood_weights", "raytrace_clear"]
+
+_SQRT2 = math.sqrt(2.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def astar(cost, start_r, start_c, goal_r, goal_c, neutral, weight, allow_unknown):  # pragma: no cover - compiled
+    """8-connected A* on a Nav2 costmap. Returns (path rows/cols as (N, 2) int64, total cost); N = 0 when unreachable.
+
+    Step cost = step length (cells) * (neutral + weight * cost / 252); cells at or above
+    INSCRIBED (253) are blocked, NO_INFORMATION (255) unless ``allow_unknown``. The heuristic
+    (octile distance * neutral) is admissible, so the path is optimal for that step cost.
+    """
+    h, w = cost.shape
+    n = h * w
+    g = np.full(n, np.inf)
+    parent = np.full(n, -1, dtype=np.int64)
+    closed = np.zeros(n, dtype=np.bool_)
+    start = start_r * w + start_c
+    goal = goal_r * w + goal_c
+    g[start] = 0.0
+    heap = [(0.0, start)]
+    dr = np.array([-1, -1, -1, 0, 0, 1, 1, 1])
+    dc = np.array([-1, 0, 1, -1, 1, -1, 0, 1])
+    while len(heap) > 0:
+        _, cur = heapq.heappop(heap)
+        if closed[cur]:
+            continue
+        closed[cur] = True
+        if cur == goal:
+            break
+        r = cur // w
+        c = cur % w
+        for k in range(8):
+            nr = r + dr[k]
+            nc = c + dc[k]
+            if nr < 0 or nc < 0 or nr >= h or nc >= w:
+                continue
+            nxt = nr * w + nc
+            if closed[nxt]:
+                continue
+            cv = cost[nr, nc]
+            if cv == 255:
+                if not allow_unknown:
+                    continue
+                cv = 0
+            elif cv >= 253:
+                continue
+            step = _SQRT2 if (dr[k] != 0 and dc[k] != 0) else 1.0
+            if dr[k] != 0 and dc[k] != 0:  # no corner cutting between two blocked cells
+                a = cost[r, nc]
+                b = cost[nr, c]
+                if (a >= 253 and (a != 255 or not allow_unknown)) or (b >= 253 and (b != 255 or not allow_unknown)):
+                    continue
+            ng = g[cur] + step * (neutral + weight * cv / 252.0)
+            if ng < g[nxt]:
+                g[nxt] = ng
+                parent[nxt] = cur
+                adr = abs(nr - goal_r)
+                adc = abs(nc - goal_c)
+                octile = (adr + adc) + (_SQRT2 - 2.0) * min(adr, adc)
+                heapq.heappush(heap, (ng + octile * neutral, nxt))
+    if not closed[goal]:
+        return np.empty((0, 2), dtype=np.int64), np.inf
+    count = 0
+    cur = goal
+    while cur != -1:
+        count += 1
+        cur = parent[cur]
+    out = np.empty((count, 2), dtype=np.int64)
+    cur = goal
+    i = count - 1
+    while cur != -1:
+        out[i, 0] = cur // w
+        out[i, 1] = cur % w
+        cur = parent[cur]
+        i -= 1
+    return out, g[goal]
+
+
+@numba.njit(cache=True, nogil=True)
+def raytrace_clear(grid, ox, oy, endpoints, hits, origin_x, origin_y, resolution, obstacle_max_range, raytrace_max_range):  # pragma: no cover
+    """Obstacle layer update: clear cells along each beam, mark lethal (254) hits within range."""
+    h, w = grid.shape
+    for i in range(endpoints.shape[0]):
+        ex = endpoints[i, 0]
+        ey = endpoints[i, 1]
+        dx = ex - ox
+        dy = ey - oy
+        dist = math.sqrt(dx * dx + dy * dy)
+        if not (dist > 0.0) or not math.isfinite(dist):
+            continue
+        clear_len = min(dist, raytrace_max_range)
+        steps = int(clear_len / (resolution * 0.5)) + 1
+        for s in range(steps):
+            t = s * resolution * 0.5 / dist
+            if t * dist >= clear_len - resolution * 0.5 and hits[i]:
+                break
+            px = ox + dx * t
+            py = oy + dy * t
+            c = int(math.floor((px - origin_x) / resolution))
+            r = int(math.floor((py - origin_y) / resolution))
+            if 0 <= r < h and 0 <= c < w:
+                grid[r, c] = 0
+        if hits[i] and dist <= obstacle_max_range:
+            c = int(math.floor((ex - origin_x) / resolution))
+            r = int(math.floor((ey - origin_y) / resolution))
+            if 0 <= r < h and 0 <= c < w:
+                grid[r, c] = 254
+
+
+@numba.njit(cache=True, nogil=True)
+def likelihood_weights(particles, ranges, angles, field, origin_x, origin_y, resolution, laser_x, laser_y, laser_yaw,
+                       range_min, range_max, z_hit, z_rand, sigma_hit, max_dist):  # pragma: no cover
+    """AMCL likelihood-field model (Nav2 amcl's LikelihoodFieldModel): the factor each particle's weight takes.
+
+    ``field`` (H, W) is the distance (m) from each cell to the nearest occupied cell, clipped
+    at ``max_dist``. Per particle: p = 1 + sum over beams of pz**3, with
+    pz = z_hit * exp(-d**2 / (2 sigma_hit**2)) + z_rand / range_max (beams at max range skipped).
+    """
+    h, w = field.shape
+    n = particles.shape[0]
+    out = np.empty(n)
+    denom = 2.0 * sigma_hit * sigma_hit
+    rand_term = z_rand / range_max
+    for i in range(n):
+        px = particles[i, 0]
+        py = particles[i, 1]
+        pth = particles[i, 2]
+        cth = math.cos(pth)
+        sth = math.sin(pth)
+        lx = px + cth * laser_x - sth * laser_y
+        ly = py + sth * laser_x + cth * laser_y
+        p = 1.0
+        for j in range(ranges.shape[0]):
+            z = ranges[j]
+            if not math.isfinite(z) or z >= range_max or z < range_min:
+                continue
+            a = pth + laser_yaw + angles[j]
+            hx = lx + z * math.cos(a)
+            hy = ly + z * math.sin(a)
+            c = int(math.floor((hx - origin_x) / resolution))
+            r = int(math.floor((hy - origin_y) / resolution))
+            if 0 <= r < h and 0 <= c < w:
+                d = field[r, c]
+            else:
+                d = max_dist
+            pz = z_hit * math.exp(-(d * d) / denom) + rand_term
+            p += pz * pz * pz
+        out[i] = p
+    return out

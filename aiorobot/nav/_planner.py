@@ -1,0 +1,115 @@
+"""Global planning on a costmap: A* (NavFn-like costs, 8-connected) and path smoothing.
+
+``plan(costmap, start_xy, goal_xy)`` returns the path as world points (N, 2) through cell
+centres, shortened by line-of-sight where that never raises the peak cost along the way, then
+resampled at the costmap's resolution, with a yaw per point (the heading to the next point; the
+last takes the goal's yaw when given).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ._costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION, Costmap
+
+__all__ = ["PlanError", "Plan", "plan"]
+
+
+class PlanError(Exception):
+    """No path: the start or goal is outside the map or in an obstacle, or the goal is unreachable."""
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A planned path: ``poses`` (N, 3) as (x, y, yaw) in the costmap's frame, its length and search cost."""
+
+    poses: NDArray[np.float64]
+    length_m: float
+    cost: float
+
+
+def _blocked(value: int, allow_unknown: bool) -> bool:
+    return value >= INSCRIBED_INFLATED_OBSTACLE and not (value == NO_INFORMATION and allow_unknown)
+
+
+def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, float], *, goal_yaw: float | None = None,
+         neutral_cost: float = 1.0, cost_factor: float = 3.0, allow_unknown: bool = True, smooth: bool = True) -> Plan:
+    """A* from ``start_xy`` to ``goal_xy`` (world, m). Raises PlanError saying why when there is no path."""
+    from ._kernels import astar
+
+    sr, sc = costmap.world_to_cell(*start_xy)
+    gr, gc = costmap.world_to_cell(*goal_xy)
+    for what, (r, c), xy in (("start", (sr, sc), start_xy), ("goal", (gr, gc), goal_xy)):
+        if not costmap.in_bounds(r, c):
+            raise PlanError(f"the {what} ({xy[0]:.2f}, {xy[1]:.2f}) is outside the map")
+    if _blocked(int(costmap.cost[gr, gc]), allow_unknown):
+        raise PlanError(f"the goal ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}) is in or too close to an obstacle (cost {int(costmap.cost[gr, gc])})")
+    cost = costmap.cost
+    if _blocked(int(cost[sr, sc]), allow_unknown):  # a start inside inflation: plan out of it as Nav2 planners do
+        cost = cost.copy()
+        cost[sr, sc] = INSCRIBED_INFLATED_OBSTACLE - 1
+    cells, total = astar(cost, sr, sc, gr, gc, float(neutral_cost), float(cost_factor), bool(allow_unknown))
+    if cells.shape[0] == 0:
+        raise PlanError(f"no path from ({start_xy[0]:.2f}, {start_xy[1]:.2f}) to ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}): the goal is unreachable")
+    if smooth and cells.shape[0] > 2:
+        cells = shortcut(cost, cells)
+    xy = np.array([costmap.cell_to_world(r, c) for r, c in cells], dtype=np.float64).reshape(-1, 2)
+    xy[0] = start_xy
+    xy[-1] = goal_xy
+    xy = resample(xy, costmap.resolution)
+    yaw = np.empty(len(xy))
+    if len(xy) > 1:
+        d = np.diff(xy, axis=0)
+        yaw[:-1] = np.arctan2(d[:, 1], d[:, 0])
+        yaw[-1] = yaw[-2] if goal_yaw is None else goal_yaw
+    else:
+        yaw[:] = 0.0 if goal_yaw is None else goal_yaw
+    seg = np.linalg.norm(np.diff(xy, axis=0), axis=1) if len(xy) > 1 else np.zeros(0)
+    return Plan(np.column_stack([xy, yaw]), float(seg.sum()), float(total))
+
+
+def _line_cells(r0: int, c0: int, r1: int, c1: int) -> list[tuple[int, int]]:
+    """Cells a straight segment between two cell centres passes through (supercover-ish sampling)."""
+    n = int(max(abs(r1 - r0), abs(c1 - c0)) * 2) + 1
+    out = []
+    for i in range(n + 1):
+        t = i / n
+        out.append((int(round(r0 + (r1 - r0) * t)), int(round(c0 + (c1 - c0) * t))))
+    return out
+
+
+def shortcut(cost: NDArray[np.uint8], cells: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Replace runs of the path by straight segments where the segment's peak cost is no higher
+    than the replaced run's (so smoothing never pulls the path closer to obstacles)."""
+    out = [cells[0]]
+    i = 0
+    n = len(cells)
+    while i < n - 1:
+        j = n - 1
+        while j > i + 1:
+            run_peak = int(cost[cells[i : j + 1, 0], cells[i : j + 1, 1]].max())
+            seg = _line_cells(int(cells[i, 0]), int(cells[i, 1]), int(cells[j, 0]), int(cells[j, 1]))
+            seg_peak = max(int(cost[r, c]) for r, c in seg)
+            if seg_peak <= run_peak and seg_peak < INSCRIBED_INFLATED_OBSTACLE:
+                break
+            j -= 1
+        out.append(cells[j])
+        i = j
+    return np.array(out, dtype=np.int64)
+
+
+def resample(xy: NDArray[np.float64], spacing: float) -> NDArray[np.float64]:
+    """Points every ``spacing`` metres along the polyline ``xy`` (N, 2), keeping both ends."""
+    if len(xy) < 2:
+        return xy.copy()
+    seg = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    if s[-1] <= 0:
+        return xy[:1].copy()
+    count = max(2, int(math.ceil(s[-1] / spacing)) + 1)
+    t = np.linspace(0.0, s[-1], count)
+    return np.column_stack([np.interp(t, s, xy[:, 0]), np.interp(t, s, xy[:, 1])])
