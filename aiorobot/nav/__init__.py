@@ -16,6 +16,7 @@ from ._costmap import (
     inflation_cost,
 )
 from ._planner import Plan, PlanError, plan
+from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
 __all__ = [
     "FREE_SPACE",
@@ -25,6 +26,9 @@ __all__ = [
     "Costmap",
     "Plan",
     "PlanError",
+    "RegulatedPurePursuit",
+    "RppCommand",
+    "RppParameters",
     "inflation_cost",
     "plan",
 ]
