@@ -7,6 +7,7 @@ they loop; they are tested without a runtime.
 
 from __future__ import annotations
 
+from ._amcl import Amcl, AmclParameters, likelihood_field
 from ._costmap import (
     FREE_SPACE,
     INSCRIBED_INFLATED_OBSTACLE,
@@ -19,6 +20,8 @@ from ._planner import Plan, PlanError, plan
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
 __all__ = [
+    "Amcl",
+    "AmclParameters",
     "FREE_SPACE",
     "INSCRIBED_INFLATED_OBSTACLE",
     "LETHAL_OBSTACLE",
@@ -30,5 +33,6 @@ __all__ = [
     "RppCommand",
     "RppParameters",
     "inflation_cost",
+    "likelihood_field",
     "plan",
 ]
