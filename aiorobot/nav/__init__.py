@@ -16,6 +16,7 @@ from ._costmap import (
     Costmap,
     inflation_cost,
 )
+from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, plan
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
@@ -25,7 +26,9 @@ __all__ = [
     "FREE_SPACE",
     "INSCRIBED_INFLATED_OBSTACLE",
     "LETHAL_OBSTACLE",
+    "MapError",
     "NO_INFORMATION",
+    "OccupancyMap",
     "Costmap",
     "Plan",
     "PlanError",
@@ -34,5 +37,7 @@ __all__ = [
     "RppParameters",
     "inflation_cost",
     "likelihood_field",
+    "load_map",
     "plan",
+    "save_map",
 ]
