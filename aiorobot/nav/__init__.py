@@ -18,9 +18,20 @@ from ._costmap import (
 )
 from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, plan
+from ._amcl_node import AmclNode
+from ._geometry import pose_stamped
+from ._map_server import MapServer
+from ._navigation_server import NavigationServer
+from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
 __all__ = [
+    "AmclNode",
+    "MapServer",
+    "NavigationServer",
+    "Navigator",
+    "TaskResult",
+    "pose_stamped",
     "Amcl",
     "AmclParameters",
     "FREE_SPACE",
