@@ -22,6 +22,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "bag": ("aiorobot.cli._bag", "record, play, inspect and repair rosbag2 (MCAP) bags"),
     "foxglove": ("aiorobot.cli._foxglove", "serve the graph live to the Foxglove app (WebSocket)"),
     "plot": ("aiorobot.cli._plot", "plot message fields over time from a bag or the live graph"),
+    "map": ("aiorobot.cli._map", "save the published map as map_server YAML + PGM"),
 }
 
 

@@ -21,6 +21,7 @@ from ._planner import Plan, PlanError, plan
 from ._amcl_node import AmclNode
 from ._geometry import pose_stamped
 from ._map_server import MapServer
+from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationServer
 from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
@@ -28,6 +29,8 @@ from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 __all__ = [
     "AmclNode",
     "MapServer",
+    "MappingNode",
+    "OccupancyMapper",
     "NavigationServer",
     "Navigator",
     "TaskResult",

@@ -159,3 +159,34 @@ def likelihood_weights(particles, ranges, angles, field, origin_x, origin_y, res
             p += pz * pz * pz
         out[i] = p
     return out
+
+
+@numba.njit(cache=True, nogil=True)
+def integrate_scan(logodds, ox, oy, endpoints, hits, origin_x, origin_y, resolution, l_free, l_occ, l_min, l_max):  # pragma: no cover
+    """Log-odds occupancy update for one scan: cells along each beam get ``l_free``, the hit cell ``l_occ``."""
+    h, w = logodds.shape
+    for i in range(endpoints.shape[0]):
+        ex = endpoints[i, 0]
+        ey = endpoints[i, 1]
+        dx = ex - ox
+        dy = ey - oy
+        dist = math.sqrt(dx * dx + dy * dy)
+        if not (dist > 0.0) or not math.isfinite(dist):
+            continue
+        hit_c = int(math.floor((ex - origin_x) / resolution))
+        hit_r = int(math.floor((ey - origin_y) / resolution))
+        steps = int(dist / (resolution * 0.5)) + 1
+        last_r = -1
+        last_c = -1
+        for s in range(steps):
+            t = s * resolution * 0.5 / dist
+            c = int(math.floor((ox + dx * t - origin_x) / resolution))
+            r = int(math.floor((oy + dy * t - origin_y) / resolution))
+            if (r == last_r and c == last_c) or (hits[i] and r == hit_r and c == hit_c):
+                continue
+            last_r = r
+            last_c = c
+            if 0 <= r < h and 0 <= c < w:
+                logodds[r, c] = max(l_min, logodds[r, c] + l_free)
+        if hits[i] and 0 <= hit_r < h and 0 <= hit_c < w:
+            logodds[hit_r, hit_c] = min(l_max, logodds[hit_r, hit_c] + l_occ)
