@@ -24,6 +24,7 @@ PARTS: dict[str, str] = {
     "cpu": "aiorobot.bench._cpu",
     "tf": "aiorobot.bench.tf",
     "bag": "aiorobot.bench._bag",
+    "nav": "aiorobot.bench._nav",
 }
 
 

@@ -75,6 +75,7 @@ class Costmap:
             )
         self.obstacles = np.zeros_like(self.static)
         self.cost = np.empty_like(self.static)
+        self._static_cost: NDArray[np.uint8] | None = None
         self.update()
 
     @classmethod
@@ -125,20 +126,43 @@ class Costmap:
                        float(self.origin[1]), float(self.resolution), float(obstacle_max_range), float(raytrace_max_range))
 
     def update(self) -> None:
-        """Combine static and obstacle layers, then inflate (Nav2's layer order)."""
+        """Combine static and obstacle layers, then inflate (Nav2's layer order).
+
+        The inflated static layer is computed once. Inflating the union of two sets of lethal
+        cells is the cell-wise maximum of inflating each (the cost falls with distance), so an
+        update only inflates the obstacle layer, inside the window its marks can reach.
+        """
+        if self._static_cost is None or self._static_cost.shape != self.static.shape:
+            self._static_cost = self._inflate(self.static)
+        cost = self._static_cost.copy()
+        marks = np.argwhere(self.obstacles == LETHAL_OBSTACLE)
+        if len(marks):
+            pad = int(math.ceil(self.inflation_radius / self.resolution)) + 1
+            r0, c0 = np.maximum(marks.min(axis=0) - pad, 0)
+            r1, c1 = np.minimum(marks.max(axis=0) + pad + 1, self.static.shape)
+            window = self._inflate(self.obstacles[r0:r1, c0:c1])
+            sub = cost[r0:r1, c0:c1]
+            merged = np.maximum(sub, window)
+            merged[sub == NO_INFORMATION] = NO_INFORMATION  # unknown stays unknown (Nav2's inflate_unknown: false)...
+            merged[self.obstacles[r0:r1, c0:c1] == LETHAL_OBSTACLE] = LETHAL_OBSTACLE  # ...unless an obstacle was seen there
+            cost[r0:r1, c0:c1] = merged
+        self.cost = cost
+
+    def _inflate(self, layer: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """``layer`` with its lethal cells inflated (cells outside ``inflation_radius`` keep their value)."""
         import cv2
 
-        master = np.maximum(self.static, self.obstacles)
-        lethal = master == LETHAL_OBSTACLE
-        cost = master.copy()
-        if lethal.any():
-            # Distance from every cell centre to the nearest lethal cell centre (exact Euclidean).
-            dist_cells = cv2.distanceTransform((~lethal).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-            dist = dist_cells.astype(np.float64) * self.resolution
-            inflated = inflation_cost(dist, self.robot_radius, self.cost_scaling_factor)
-            within = (dist <= self.inflation_radius + 1e-9) & (master != NO_INFORMATION)
-            cost[within] = np.maximum(cost[within], inflated[within])
-        self.cost = cost
+        lethal = layer == LETHAL_OBSTACLE
+        cost = layer.copy()
+        if not lethal.any():
+            return cost
+        # Distance from every cell centre to the nearest lethal cell centre (exact Euclidean).
+        dist = cv2.distanceTransform((~lethal).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        within = (dist <= (self.inflation_radius + 1e-9) / self.resolution) & (layer != NO_INFORMATION)
+        if within.any():
+            inflated = inflation_cost(dist[within].astype(np.float64) * self.resolution, self.robot_radius, self.cost_scaling_factor)
+            cost[within] = np.maximum(cost[within], inflated)
+        return cost
 
     def to_occupancy(self) -> NDArray[np.int8]:
         """The costmap as OccupancyGrid data (Nav2's costmap topic scaling: 0..100, -1 unknown)."""

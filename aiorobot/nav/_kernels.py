@@ -190,3 +190,51 @@ def integrate_scan(logodds, ox, oy, endpoints, hits, origin_x, origin_y, resolut
                 logodds[r, c] = max(l_min, logodds[r, c] + l_free)
         if hits[i] and 0 <= hit_r < h and 0 <= hit_c < w:
             logodds[hit_r, hit_c] = min(l_max, logodds[hit_r, hit_c] + l_occ)
+
+
+@numba.njit(cache=True, nogil=True)
+def _segment_peak(cost, r0, c0, r1, c1):  # pragma: no cover
+    n = int(max(abs(r1 - r0), abs(c1 - c0)) * 2) + 1
+    peak = 0
+    for i in range(n + 1):
+        t = i / n
+        r = int(round(r0 + (r1 - r0) * t))
+        c = int(round(c0 + (c1 - c0) * t))
+        v = cost[r, c]
+        if v > peak:
+            peak = v
+    return peak
+
+
+@numba.njit(cache=True, nogil=True)
+def shortcut(cost, cells, max_skip):  # pragma: no cover
+    """Greedy line-of-sight shortening: from each kept cell jump to the farthest cell (within
+    ``max_skip``) whose straight segment's peak cost is no higher than the skipped run's peak
+    and below INSCRIBED (253). Returns the kept cells (K, 2)."""
+    n = cells.shape[0]
+    keep = np.empty(n, dtype=np.int64)
+    k = 0
+    i = 0
+    keep[k] = 0
+    k += 1
+    while i < n - 1:
+        best = i + 1
+        run_peak = cost[cells[i, 0], cells[i, 1]]
+        j = i + 1
+        limit = min(n - 1, i + max_skip)
+        while j <= limit:
+            v = cost[cells[j, 0], cells[j, 1]]
+            if v > run_peak:
+                run_peak = v
+            seg = _segment_peak(cost, cells[i, 0], cells[i, 1], cells[j, 0], cells[j, 1])
+            if seg <= run_peak and seg < 253:
+                best = j
+            j += 1
+        keep[k] = best
+        k += 1
+        i = best
+    out = np.empty((k, 2), dtype=np.int64)
+    for m in range(k):
+        out[m, 0] = cells[keep[m], 0]
+        out[m, 1] = cells[keep[m], 1]
+    return out

@@ -72,34 +72,12 @@ def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, 
     return Plan(np.column_stack([xy, yaw]), float(seg.sum()), float(total))
 
 
-def _line_cells(r0: int, c0: int, r1: int, c1: int) -> list[tuple[int, int]]:
-    """Cells a straight segment between two cell centres passes through (supercover-ish sampling)."""
-    n = int(max(abs(r1 - r0), abs(c1 - c0)) * 2) + 1
-    out = []
-    for i in range(n + 1):
-        t = i / n
-        out.append((int(round(r0 + (r1 - r0) * t)), int(round(c0 + (c1 - c0) * t))))
-    return out
-
-
-def shortcut(cost: NDArray[np.uint8], cells: NDArray[np.int64]) -> NDArray[np.int64]:
+def shortcut(cost: NDArray[np.uint8], cells: NDArray[np.int64], max_skip: int = 400) -> NDArray[np.int64]:
     """Replace runs of the path by straight segments where the segment's peak cost is no higher
     than the replaced run's (so smoothing never pulls the path closer to obstacles)."""
-    out = [cells[0]]
-    i = 0
-    n = len(cells)
-    while i < n - 1:
-        j = n - 1
-        while j > i + 1:
-            run_peak = int(cost[cells[i : j + 1, 0], cells[i : j + 1, 1]].max())
-            seg = _line_cells(int(cells[i, 0]), int(cells[i, 1]), int(cells[j, 0]), int(cells[j, 1]))
-            seg_peak = max(int(cost[r, c]) for r, c in seg)
-            if seg_peak <= run_peak and seg_peak < INSCRIBED_INFLATED_OBSTACLE:
-                break
-            j -= 1
-        out.append(cells[j])
-        i = j
-    return np.array(out, dtype=np.int64)
+    from ._kernels import shortcut as kernel
+
+    return kernel(np.ascontiguousarray(cost), np.ascontiguousarray(cells, dtype=np.int64), int(max_skip))
 
 
 def resample(xy: NDArray[np.float64], spacing: float) -> NDArray[np.float64]:
