@@ -25,6 +25,12 @@ _EXPORTS = {
     "Clock": "_clock",
     "ClockPublisher": "_clock_publisher",
     "ClockType": "_time",
+    "ClockChange": "_clock",
+    "Infinite": "_time",
+    "JumpHandle": "_clock",
+    "JumpThreshold": "_clock",
+    "ROSClock": "_clock",
+    "TimeJump": "_clock",
     "ConfigError": "_config",
     "DurabilityPolicy": "_qos",
     "Duration": "_time",
@@ -84,6 +90,7 @@ __all__ = [
     "Clock",
     "ClockPublisher",
     "ClockType",
+    "ClockChange",
     "ConfigError",
     "DurabilityPolicy",
     "Duration",
@@ -94,7 +101,10 @@ __all__ = [
     "GraphConfig",
     "HistoryPolicy",
     "InvalidNameError",
+    "Infinite",
     "InvalidParameterValueError",
+    "JumpHandle",
+    "JumpThreshold",
     "LocalTransport",
     "MessageStream",
     "MutuallyExclusiveCallbackGroup",
@@ -110,6 +120,7 @@ __all__ = [
     "Publisher",
     "QoSIncompatibleError",
     "QoSProfile",
+    "ROSClock",
     "Rate",
     "ReentrantCallbackGroup",
     "ReliabilityPolicy",
@@ -122,6 +133,7 @@ __all__ = [
     "SetParametersResult",
     "Subscription",
     "Time",
+    "TimeJump",
     "Timer",
     "TimerStatistics",
     "TopicInfo",
@@ -135,7 +147,7 @@ __all__ = [
 
 if TYPE_CHECKING:
     from ._actions import ActionClient, ActionServer, CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
-    from ._clock import Clock
+    from ._clock import Clock, ClockChange, JumpHandle, JumpThreshold, ROSClock, TimeJump
     from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
@@ -148,7 +160,7 @@ if TYPE_CHECKING:
     from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default
     from ._runtime import Runtime, run
     from ._services import Client, Service, ServiceUnavailableError
-    from ._time import ClockType, Duration, Time
+    from ._time import ClockType, Duration, Infinite, Time
     from ._timer import Rate, Timer, TimerStatistics
     from ._transport import LocalTransport, Transport
 
