@@ -16,6 +16,11 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 _EXPORTS = {
+    "ParameterUninitializedError": "_errors",
+    "ParameterImmutableError": "_errors",
+    "InvalidParameterTypeError": "_errors",
+    "IntegerRange": "_parameters",
+    "FloatingPointRange": "_parameters",
     "ActionClient": "_actions",
     "ActionServer": "_actions",
     "CallbackGroup": "_groups",
@@ -81,6 +86,11 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "ParameterUninitializedError",
+    "ParameterImmutableError",
+    "InvalidParameterTypeError",
+    "IntegerRange",
+    "FloatingPointRange",
     "ActionClient",
     "ActionServer",
     "CallbackGroup",
@@ -150,12 +160,13 @@ if TYPE_CHECKING:
     from ._clock import Clock, ClockChange, JumpHandle, JumpThreshold, ROSClock, TimeJump
     from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
+    from ._errors import InvalidParameterTypeError, ParameterImmutableError, ParameterUninitializedError
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
     from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
     from ._logging import NodeLogger, setup_logging
     from ._node import Node
-    from ._parameters import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
+    from ._parameters import FloatingPointRange, IntegerRange, Parameter, ParameterDescriptor, ParameterType, SetParametersResult
     from ._pubsub import MessageStream, Publisher, Subscription
     from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default
     from ._runtime import Runtime, run
