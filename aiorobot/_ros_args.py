@@ -98,6 +98,11 @@ def parse_ros_args(argv: Sequence[str]) -> RosArgs:
         if arg in _FLAGS_WITHOUT_VALUE:
             i += 1
             continue
+        if arg not in ("-p", "--param", "-r", "--remap", "--params-file", "--log-level", *_FLAGS_WITH_VALUE):
+            raise RosArgsError(
+                f"unknown ROS argument {arg!r} after --ros-args; expected -p name:=value, -r from:=to, "
+                "--params-file FILE or --log-level LEVEL (end ROS arguments with --)"
+            )
         value = _value_of(args, i)
         if arg in ("-p", "--param"):
             node, name, text = _rule(arg, value, "name:=value")
@@ -114,20 +119,14 @@ def parse_ros_args(argv: Sequence[str]) -> RosArgs:
                     f"--log-level: expected a level ({', '.join(LOG_LEVELS)}) or logger:=level, found {value!r}"
                 )
             result.log_levels[logger if sep else ""] = "warning" if level.lower() == "warn" else level.lower()
-        elif arg in _FLAGS_WITH_VALUE:
-            pass
-        else:
-            raise RosArgsError(
-                f"unknown ROS argument {arg!r} after --ros-args; expected -p name:=value, -r from:=to, "
-                "--params-file FILE or --log-level LEVEL (end ROS arguments with --)"
-            )
         i += 2
     return result
 
 
 def _value_of(args: list[str], i: int) -> str:
     if i + 1 >= len(args) or args[i + 1] in ("--", "--ros-args"):
-        raise RosArgsError(f"{args[i]}: expected a value after it, found {'nothing' if i + 1 >= len(args) else args[i + 1]!r}")
+        found = "nothing" if i + 1 >= len(args) else repr(args[i + 1])
+        raise RosArgsError(f"{args[i]}: expected a value after it, found {found}")
     return args[i + 1]
 
 
