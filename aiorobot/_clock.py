@@ -123,6 +123,10 @@ class Clock:
     With ``use_sim_time`` the clock reads zero until the first ``/clock`` message,
     then follows it; waiters (timers, rates, timeouts) wake when sim time reaches
     their deadline, and get :class:`ClockJump` when it jumps backwards.
+
+    rclpy difference: ``Clock()`` is a ROS_TIME clock (rclpy's default is SYSTEM_TIME),
+    and ``ROSClock`` is this class itself rather than a subclass, so every clock has
+    ``ros_time_is_active`` and ``set_ros_time_override``.
     """
 
     def __init__(self, clock_type: ClockType = ClockType.ROS_TIME, *, use_sim_time: bool = False):

@@ -63,7 +63,12 @@ class InvalidParameterValueError(ParameterError):
 
 class InvalidParameterTypeError(InvalidParameterValueError):
     """A value's type does not match the parameter's declared (static) type (rclpy's
-    ``InvalidParameterTypeException``); an :class:`InvalidParameterValueError` too."""
+    ``InvalidParameterTypeException``).
+
+    rclpy difference: it is also an :class:`InvalidParameterValueError`, so code that
+    catches bad values catches bad types too; the rclpy exception is unrelated to
+    ``InvalidParameterValueException``.
+    """
 
 
 class ParameterImmutableError(ParameterError):

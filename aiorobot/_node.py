@@ -62,6 +62,10 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         As in rclpy: setting undeclared parameters declares them (dynamically typed);
         every override is declared at construction; the ``~/get_parameters`` family of
         services is created. ``/parameter_events`` is always published.
+
+    rclpy difference: the ``use_sim_time`` parameter, when nothing sets it, follows
+    ``Runtime(use_sim_time=...)`` instead of defaulting to false, so one runtime flag
+    switches every node; ``parameter_overrides`` also takes a ``{name: value}`` mapping.
     """
 
     def __init__(
@@ -245,7 +249,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             self._call_soon(timer._start)
         return timer
 
-    def create_rate(self, frequency: float, clock: Clock | None = None) -> Rate:
+    def create_rate(self, frequency: float) -> Rate:
         """A :class:`Rate` of ``frequency`` Hz on this node's clock; ``TypeError`` for a non-number
         (``create_rate(None)``) and ``ValueError`` for one <= 0, as rclpy."""
         if isinstance(frequency, bool) or not isinstance(frequency, (int, float)):

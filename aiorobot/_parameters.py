@@ -30,7 +30,12 @@ SEPARATOR = "."
 
 
 class ParameterType(enum.IntEnum):
-    """Values as ``rcl_interfaces/msg/ParameterType``; also ``Parameter.Type``."""
+    """Values as ``rcl_interfaces/msg/ParameterType``; also ``Parameter.Type``.
+
+    rclpy difference: ``bytes`` is a BYTE_ARRAY value, a list mixing ints and floats is a
+    DOUBLE_ARRAY (rclpy raises ``TypeError``), and an empty list fits any array type (rclpy
+    calls it a BYTE_ARRAY, so it cannot be set on a string-array parameter).
+    """
 
     NOT_SET = 0
     BOOL = 1

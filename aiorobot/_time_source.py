@@ -28,6 +28,7 @@ PARAMETER = "use_sim_time"
 class TimeSource:
     """Keeps ``node``'s clock in step with its ``use_sim_time`` parameter."""
 
+
     def __init__(self, node: Node) -> None:
         self.node = node
         store = node._parameters
