@@ -337,3 +337,85 @@ def test_create_rate_checks_its_frequency():
         node.create_rate(None)  # type: ignore[arg-type]
     with pytest.raises(ValueError):
         node.create_rate(0.0)
+
+
+def test_declare_parameters_typed_overrides_and_partial_failures():
+    # rclpy test_node.py::test_declare_parameters
+    node = Node(
+        "n",
+        parameter_overrides={
+            "initial_foo": 4321,
+            "initial_decl_wrong_type": "a string",
+            "initial_decl_with_type": 3.14,
+            "namespace.k_initial_foo": 4321,
+            "initial_bar": "override",
+        },
+    )
+    assert node.declare_parameter("no_override", Parameter.Type.INTEGER).type_ == Parameter.Type.NOT_SET
+    with pytest.raises(InvalidParameterTypeError):
+        node.declare_parameter("initial_decl_wrong_type", Parameter.Type.INTEGER)
+    assert node.declare_parameter("initial_decl_with_type", Parameter.Type.DOUBLE).value == 3.14
+    params = [("k_initial_foo", 0, ParameterDescriptor()), ("k_foo", 42, ParameterDescriptor()), ("k_baz", 2.41),
+              ("k_value_not_set",)]
+    assert [p.value for p in node.declare_parameters("namespace", params)] == [4321, 42, 2.41, None]
+    ignoring = [("initial_bar", "ignoring_override", ParameterDescriptor())]
+    assert node.declare_parameters("", ignoring, ignore_override=True)[0].value == "ignoring_override"
+    with pytest.raises(ParameterAlreadyDeclaredError):
+        node.declare_parameters("", [("foobar", 43), ("initial_bar", "x")])
+    assert not node.has_parameter("foobar")  # nothing declared when one name is taken
+    with pytest.raises(InvalidParameterValueError):
+        node.declare_parameters("", [("foobarbar", 44), ("", 2.41)])
+    node.add_on_set_parameters_callback(
+        lambda ps: SetParametersResult(successful=not any("reject" in p.name for p in ps))
+    )
+    with pytest.raises(InvalidParameterValueError):
+        node.declare_parameters("", [("im_ok", 44), ("reject_me", 2.41)])
+    assert node.has_parameter("im_ok") and not node.has_parameter("reject_me")  # one at a time, as rclpy
+    with pytest.raises(ValueError):
+        node.declare_parameter("wrong_parameter_value_type_not_set", Parameter.Type.NOT_SET)
+
+
+def test_node_set_parameters_applies_those_before_an_undeclared_one():
+    # rclpy test_node.py::test_node_set_parameters (the non-allow-undeclared node)
+    node = Node("n")
+    node.declare_parameters("", [("foo", 42, ParameterDescriptor()), ("bar", "hello"), ("baz", 2.41)])
+    params = [Parameter("foo", value=24), Parameter("bar", value="bye"), Parameter("baz", value=1.42),
+              Parameter("foobar", value=1.42)]
+    with pytest.raises(ParameterNotDeclaredError):
+        node.set_parameters(params)
+    assert [node.get_parameter(n).value for n in ("foo", "bar", "baz")] == [24, "bye", 1.42]
+    with pytest.raises(ParameterNotDeclaredError):
+        node.get_parameter("foobar")
+
+
+def test_node_set_parameters_rejection_list():
+    # rclpy test_node.py::test_node_set_parameters_rejection_list
+    node = Node("n")
+    node.declare_parameters("", [("reject", True, ParameterDescriptor()), ("accept", True, ParameterDescriptor()),
+                                 ("accept", True, ParameterDescriptor())])
+    node.add_on_set_parameters_callback(lambda ps: SetParametersResult(successful=not any("reject" in p.name for p in ps)))
+    node.add_on_set_parameters_callback(lambda ps: SetParametersResult(successful=not any("refuse" in p.name for p in ps)))
+    results = node.set_parameters([Parameter("reject", value=True), Parameter("accept", value=True),
+                                   Parameter("accept", value=True)])
+    assert [r.successful for r in results] == [False, True, True]
+
+
+def test_node_set_parameters_read_only():
+    # rclpy test_node.py::test_node_set_parameters_read_only
+    node = Node("n")
+    node.declare_parameters("", [("immutable_foo", 42, ParameterDescriptor(read_only=True)), ("bar", "hello"),
+                                 ("immutable_baz", 2.41, ParameterDescriptor(read_only=True))])
+    results = node.set_parameters([Parameter("immutable_foo", value=24), Parameter("bar", value="bye"),
+                                   Parameter("immutable_baz", value=1.42)])
+    assert [r.successful for r in results] == [False, True, False]
+    assert [node.get_parameter(n).value for n in ("immutable_foo", "bar", "immutable_baz")] == [42, "bye", 2.41]
+
+
+def test_node_set_parameters_pre_set_parameter_callback_adding_undeclared():
+    # rclpy test_node.py::test_node_set_parameters_pre_set_parameter_callback
+    node = Node("n")
+    node.declare_parameter("foo", 0)
+    node.add_pre_set_parameters_callback(modify_parameter_callback)
+    with pytest.raises(ParameterNotDeclaredError):
+        node.set_parameters([Parameter("foo", Parameter.Type.INTEGER, 42)])
+    assert node.get_parameter("foo").value == 0 and not node.has_parameter("bar")
