@@ -51,3 +51,21 @@ async def test_switching_use_sim_time_at_run_time():
         assert await sleeper is False  # the time base changed under the sleep, as rclpy
         assert node.now().nanoseconds > 1_000_000_000_000_000_000
         assert not node.set_parameters([Parameter("use_sim_time", value="yes")])[0].successful
+
+
+async def test_timers_follow_the_switched_clock():
+    # a node switched to ROS time at run time: its timers fire on /clock, not on the wall clock
+    async with Runtime(handle_signals=False) as rt:
+        clock_pub = rt.add_node(ClockPublisher())
+        node = rt.add_node(Node("n"))
+        ticks: list[int] = []
+        node.create_timer(100.0, lambda: ticks.append(node.now().nanoseconds))  # never on the wall clock here
+        await settle(rt)
+        clock_pub.publish_time(1_000_000_000)
+        node.set_parameters([Parameter("use_sim_time", value=True)])
+        await settle(rt)
+        for step in range(2, 202):  # sim time 2 s .. 201 s in 1 s steps
+            clock_pub.publish_time(step * 1_000_000_000)
+            await settle(rt)
+        # the period restarted at the switch, on the node's new clock (0 until its first /clock)
+        assert ticks == [100_000_000_000, 200_000_000_000]
