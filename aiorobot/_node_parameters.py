@@ -106,6 +106,13 @@ class NodeParametersMixin:
     def describe_parameters(self, names: Iterable[str]) -> list[ParameterDescriptor]:
         return [self._parameters.describe(n) for n in names]
 
+    def set_descriptor(self, name: str, descriptor: Any, alternative_value: Any = None) -> Any:
+        """Replace a parameter's descriptor (rclpy's): a value that breaks the new descriptor is
+        replaced by ``alternative_value`` (an ``rcl_interfaces`` ParameterValue) or raises
+        ``InvalidParameterValueError``; a read-only parameter raises ``ParameterImmutableError``.
+        Returns the parameter's value as a ParameterValue."""
+        return self._parameters.set_descriptor(name, descriptor, alternative_value)
+
     def list_parameters(self, prefixes: Sequence[str] | None = None, depth: int = 0) -> Any:
         """rclpy's ``list_parameters(prefixes, depth)`` -> ``rcl_interfaces/msg/ListParametersResult``
         (``names``, ``prefixes``); ``depth`` 0 lists recursively.

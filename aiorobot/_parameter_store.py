@@ -45,7 +45,7 @@ PostSetCallback = Callable[[list[Parameter]], Any]
 #: event hook: (new, changed, deleted) parameters of one committed change
 EventHook = Callable[[list[Parameter], list[Parameter], list[Parameter]], None]
 
-_WRONG_TYPE = "wrong parameter type"
+_WRONG_TYPE = "Wrong parameter type"  # rclpy's reason prefixes, which callers test
 
 
 def _override_value(value: Any) -> Any:
@@ -208,6 +208,31 @@ class ParameterStore:
         if self.event_hook is not None:
             self.event_hook([], [], [param])
 
+    def set_descriptor(self, name: str, descriptor: Any, alternative_value: Any = None) -> Any:
+        """rclpy's ``set_descriptor``: a new descriptor for a declared parameter; when the current
+        value breaks it, ``alternative_value`` (a ParameterValue) replaces it or
+        ``InvalidParameterValueError`` is raised. Returns the value as a ParameterValue."""
+        if name not in self._values:
+            if self.allow_undeclared:
+                return self.get(name).get_parameter_value()
+            raise self._not_declared(name)
+        if self._descriptors[name].read_only:
+            raise ParameterImmutableError(f"parameter {name!r} of {self.owner} is read-only; its descriptor is fixed")
+        d = as_descriptor(descriptor)
+        d.name = name
+        current = self._values[name]
+        result, value = self._vet(current, d, check_read_only=False)
+        if not result.successful and alternative_value is not None:
+            alternative = Parameter(name, ParameterType(alternative_value.type), parameter_value_to_python(alternative_value))
+            result, value = self._vet(alternative, d, check_read_only=False)
+        if not result.successful:
+            raise InvalidParameterValueError(name, result.reason)
+        if d.dynamic_typing:
+            d.type = value.type_
+        self._descriptors[name] = d
+        self._values[name] = value
+        return value.get_parameter_value()
+
     def unclaimed_overrides(self) -> list[str]:
         return sorted(set(self.overrides) - self._claimed - self._quiet)
 
@@ -360,7 +385,7 @@ class ParameterStore:
             return SetParametersResult(True), param
         if param.type_ is ParameterType.NOT_SET:
             if param.name in self._values:
-                return SetParametersResult(False, f"static parameter {param.name!r} cannot be undeclared"), param
+                return SetParametersResult(False, f"Static parameter cannot be undeclared ({param.name!r})"), param
             return SetParametersResult(True), param  # typed declaration without a value
         try:
             value = coerce(d.type, param.value)

@@ -419,3 +419,86 @@ def test_node_set_parameters_pre_set_parameter_callback_adding_undeclared():
     with pytest.raises(ParameterNotDeclaredError):
         node.set_parameters([Parameter("foo", Parameter.Type.INTEGER, 42)])
     assert node.get_parameter("foo").value == 0 and not node.has_parameter("bar")
+
+
+def test_set_descriptor():
+    # rclpy test_node.py::test_set_descriptor, ::test_set_descriptor_read_only
+    node = Node("n")
+    with pytest.raises(ParameterNotDeclaredError):
+        node.set_descriptor("foo", ParameterDescriptor())
+    node.declare_parameter("foo", "hello", ParameterDescriptor())
+    assert node.describe_parameter("foo") == ParameterDescriptor(name="foo", type=Parameter.Type.STRING)
+    value = node.set_descriptor("foo", ParameterDescriptor(
+        name="this will be ignored", type=Parameter.Type.INTEGER, additional_constraints="some constraints",
+        integer_range=[IntegerRange(-10, 10, 2)], dynamic_typing=True))
+    assert (value.type, value.string_value) == (int(Parameter.Type.STRING), "hello")
+    d = node.describe_parameter("foo")
+    assert (d.name, d.type, d.additional_constraints) == ("foo", Parameter.Type.STRING, "some constraints")
+    assert d.integer_range[0] == IntegerRange(-10, 10, 2)
+    node.set_descriptor("foo", ri.ParameterDescriptor(type=4, read_only=True, floating_point_range=[
+        ri.FloatingPointRange(from_value=-2.0, to_value=2.0, step=0.1)]))
+    d = node.describe_parameter("foo")
+    assert d.read_only and d.floating_point_range[0] == FloatingPointRange(-2.0, 2.0, 0.1)
+    with pytest.raises(ParameterImmutableError):
+        node.set_descriptor("foo", ParameterDescriptor())
+    node.declare_parameter("n", 5)
+    with pytest.raises(InvalidParameterValueError):
+        node.set_descriptor("n", ParameterDescriptor(type=Parameter.Type.INTEGER, integer_range=[IntegerRange(0, 3)]))
+    alt = ri.ParameterValue(type=2, integer_value=3)
+    assert node.set_descriptor("n", ParameterDescriptor(type=Parameter.Type.INTEGER, integer_range=[IntegerRange(0, 3)]),
+                               alt).integer_value == 3
+    assert node.get_parameter("n").value == 3
+
+
+@pytest.mark.parametrize(
+    ("kind", "rng", "good", "bad_step", "bad_range"),
+    [
+        ("float", FloatingPointRange(0.0, 10.0, 0.5), [0.0, 10.0, 4.5], 4.25, 12.0),
+        ("int", IntegerRange(0, 10, 2), [0, 10, 4], 5, 12),
+    ],
+)
+def test_range_descriptors(kind, rng, good, bad_step, bad_range):
+    # rclpy test_node.py::test_floating_point_range_descriptor, ::test_integer_range_descriptor
+    node = Node("n")
+    field = "floating_point_range" if kind == "float" else "integer_range"
+    d = lambda: ParameterDescriptor(**{field: [rng]})  # noqa: E731
+    other = 123 if kind == "float" else 123.0  # a value of the other numeric type ignores the range
+    result = node.declare_parameters("", [("from_value", good[0], d()), ("to_value", good[1], d()),
+                                          ("in_range", good[2], d()), ("str_value", "no number", d()),
+                                          ("other", other, d())])
+    assert [p.value for p in result] == [*good, "no number", other]
+    assert not node.set_parameters([Parameter("in_range", value=bad_range)])[0].successful
+    assert not node.set_parameters([Parameter("in_range", value=bad_step)])[0].successful
+    assert node.get_parameter("in_range").value == good[2]
+    wide = (FloatingPointRange(-10.0, 0.0, 30.0) if kind == "float" else IntegerRange(-10, 0, 30))
+    w = lambda: ParameterDescriptor(**{field: [wide]})  # noqa: E731
+    with pytest.raises(InvalidParameterValueError):
+        node.declare_parameters("", [("from_value_2", type(good[0])(-10), w()), ("to_value_2", type(good[0])(0), w()),
+                                     ("in_range_bad_step", type(good[0])(-4), w()), ("out_of_range", type(good[0])(30), w())])
+    assert node.has_parameter("from_value_2") and node.has_parameter("to_value_2")  # edges are always valid
+    assert not node.has_parameter("in_range_bad_step") and not node.has_parameter("out_of_range")
+
+
+def test_static_dynamic_typing():
+    # rclpy test_node.py::test_static_dynamic_typing
+    node = Node("n")
+    node.declare_parameters("", [("int_param", 0), ("int_param_no_default", Parameter.Type.INTEGER),
+                                 ("dynamic_param", None, ParameterDescriptor(dynamic_typing=True))])
+    assert node.get_parameter("int_param").type_ == Parameter.Type.INTEGER
+    with pytest.raises(ParameterUninitializedError):
+        node.get_parameter("int_param_no_default")
+    assert node.get_parameter("dynamic_param").type_ == Parameter.Type.NOT_SET
+    result = node.set_parameters([Parameter("int_param", value="asd")])[0]
+    assert not result.successful and result.reason.startswith("Wrong parameter type")
+    assert node.set_parameters([Parameter("int_param", value=3)])[0].successful
+    result = node.set_parameters([Parameter("int_param_no_default", value="asd")])[0]
+    assert result.reason.startswith("Wrong parameter type")
+    assert node.set_parameters([Parameter("int_param_no_default", value=3)])[0].successful
+    result = node.set_parameters([Parameter("int_param_no_default", value=None)])[0]
+    assert result.reason.startswith("Static parameter cannot be undeclared")
+    assert node.set_parameters([Parameter("dynamic_param", value="asd")])[0].successful
+    assert node.set_parameters([Parameter("dynamic_param", value=3)])[0].successful
+    result = node.set_parameters_atomically([Parameter("dynamic_param", value=3), Parameter("int_param", value="asd")])
+    assert result.reason.startswith("Wrong parameter type")
+    assert node.set_parameters_atomically([Parameter("dynamic_param", value=None), Parameter("int_param", value=4)]).successful
+    assert node.get_parameter("int_param").value == 4 and not node.has_parameter("dynamic_param")
