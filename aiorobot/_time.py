@@ -54,6 +54,10 @@ class Duration:
 
     @classmethod
     def from_msg(cls, msg: Any) -> Duration:
+        """From a ``builtin_interfaces/msg/Duration`` (anything with ``sec`` and ``nanosec``);
+        ``TypeError`` for anything else, as rclpy."""
+        if not (hasattr(msg, "sec") and hasattr(msg, "nanosec")):
+            raise TypeError(f"Duration.from_msg: expected a builtin_interfaces/msg/Duration, found {msg!r}")
         return cls(seconds=int(msg.sec), nanoseconds=int(msg.nanosec))
 
     def to_msg(self) -> Any:
@@ -165,6 +169,10 @@ class Time:
 
     @classmethod
     def from_msg(cls, msg: Any, clock_type: ClockType = ClockType.ROS_TIME) -> Time:
+        """From a ``builtin_interfaces/msg/Time`` (anything with ``sec`` and ``nanosec``);
+        ``TypeError`` for anything else, as rclpy."""
+        if not (hasattr(msg, "sec") and hasattr(msg, "nanosec")):
+            raise TypeError(f"Time.from_msg: expected a builtin_interfaces/msg/Time, found {msg!r}")
         return cls(seconds=int(msg.sec), nanoseconds=int(msg.nanosec), clock_type=clock_type)
 
     def to_msg(self) -> Any:

@@ -5,6 +5,12 @@ Every node declares ``use_sim_time``. Left alone, it follows the runtime (and re
 parameter file, ``-p use_sim_time:=true`` or a set at run time - gets a clock of its
 own, fed from ``/clock`` by a subscription of its own when it is on, and its timers
 restart their period on the new time base.
+
+A node that follows the runtime shares the runtime's clock; its first switch moves it to
+a clock of its own, so jump callbacks registered on ``node.get_clock()`` before that
+switch stay on the runtime's clock (register them after setting ``use_sim_time``, or
+give the node a ``use_sim_time`` override, which gives it its own clock from the start
+when it differs from the runtime's).
 """
 
 from __future__ import annotations

@@ -153,3 +153,11 @@ def test_infinite_duration():
 
 def test_times_hash_by_value():
     assert len({Time(seconds=1), Time(nanoseconds=1_000_000_000)}) == 1
+
+
+def test_from_msg_rejects_other_objects():
+    # rclpy time.py / duration.py from_msg: TypeError for a non-message
+    with pytest.raises(TypeError, match="expected a builtin_interfaces/msg/Time"):
+        Time.from_msg(5)
+    with pytest.raises(TypeError, match="expected a builtin_interfaces/msg/Duration"):
+        Duration.from_msg("1s")
