@@ -177,7 +177,7 @@ if TYPE_CHECKING:
 
 
 _SUBPACKAGES = frozenset(
-    {"control", "fusion", "lifecycle", "message_filters", "msgs", "perception", "testing", "tf"}
+    {"control", "fusion", "lifecycle", "message_filters", "msgs", "parameters", "perception", "testing", "tf"}
 )
 
 

@@ -24,7 +24,7 @@ from ._logging import NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
 from ._node_graph import NodeGraphMixin
 from ._node_parameters import NodeParametersMixin
-from ._parameter_store import ParameterStore
+from .parameters._store import ParameterStore
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile
 from ._services import Client, Service
@@ -118,7 +118,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
     def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
         """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
-        from ._parameter_services import ParameterEventPublisher, create_parameter_services
+        from .parameters._services import ParameterEventPublisher, create_parameter_services
         from ._time_source import TimeSource
 
         self._parameters.event_hook = ParameterEventPublisher(self)

@@ -36,7 +36,7 @@ def resolve_node_arguments(
         return NodeArguments(overrides, remappings)
     if isinstance(cli_args, str) or not all(isinstance(a, str) for a in cli_args):
         raise TypeError(f"cli_args: expected a list of str, found {cli_args!r}")
-    from ._parameter_files import load_parameter_file
+    from .parameters._files import load_parameter_file
     from ._ros_args import parse_ros_args
 
     args = parse_ros_args(list(cli_args))

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
-from ._parameter_store import OnSetCallback, ParameterStore, PostSetCallback, PreSetCallback
+from .parameters._store import OnSetCallback, ParameterStore, PostSetCallback, PreSetCallback
 from ._parameters import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
 
 __all__ = ["NodeParametersMixin"]

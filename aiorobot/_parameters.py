@@ -2,7 +2,7 @@
 conversions to and from ``rcl_interfaces`` messages.
 
 The node-side rules (declaration, overrides, callbacks, events) live in
-:mod:`aiorobot._parameter_store`.
+:mod:`aiorobot.parameters._store`.
 """
 
 from __future__ import annotations

@@ -64,7 +64,7 @@ def _log_level(ros_args: list[str]) -> str:
 def build_node(spec: str, cli_args: list[str]) -> Any:
     """Import ``spec`` and construct it with ``cli_args``; ``_UsageError`` with one line on any problem."""
     from aiorobot import Node, ParameterError
-    from aiorobot._parameter_files import ParameterFileError
+    from aiorobot.parameters import ParameterFileError
     from aiorobot._ros_args import RosArgsError, parse_ros_args
 
     try:

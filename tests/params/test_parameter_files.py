@@ -7,7 +7,7 @@ import textwrap
 import pytest
 
 from aiorobot import Node, Parameter, ParameterNotDeclaredError
-from aiorobot._parameter_files import ParameterFileError, load_parameter_file, parameter_dict_from_yaml_file
+from aiorobot.parameters import ParameterFileError, load_parameter_file, parameter_dict_from_yaml_file
 
 # Every section kind of rclpy's wildcards.yaml resource, keys repeated as there.
 WILDCARDS = """\

@@ -7,7 +7,7 @@ from array import array
 import pytest
 
 from aiorobot import Parameter
-from aiorobot._parameters import get_parameter_value, parameter_value_to_python
+from aiorobot.parameters import get_parameter_value, parameter_value_to_python
 from aiorobot.msgs.rcl_interfaces import Parameter as ParameterMsg
 from aiorobot.msgs.rcl_interfaces import ParameterType, ParameterValue
 

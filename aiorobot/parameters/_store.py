@@ -16,7 +16,7 @@ import inspect
 from collections.abc import Awaitable, Callable, Generator, Iterable, Mapping, Sequence
 from typing import Any
 
-from ._errors import (
+from .._errors import (
     InvalidParameterTypeError,
     InvalidParameterValueError,
     ParameterAlreadyDeclaredError,
@@ -24,7 +24,7 @@ from ._errors import (
     ParameterNotDeclaredError,
     ParameterUninitializedError,
 )
-from ._parameters import (
+from .._parameters import (
     SEPARATOR,
     FloatingPointRange,
     IntegerRange,
@@ -151,7 +151,7 @@ class ParameterStore:
                     )
                 d.type = second
             else:
-                value = _override_value(second) if not _is_value_msg(second) else second
+                value = second if _is_value_msg(second) else _override_value(second)
                 if not d.dynamic_typing:
                     if _is_value_msg(value):
                         d.type = ParameterType(value.type)
@@ -409,7 +409,7 @@ class ParameterStore:
             d = (descriptors or self._descriptors).get(param.name)
             result, param = self._vet(param, d, check_read_only=not declaring)
             if not result.successful:
-                return _fail(result)
+                return result
             vetted.append(param)
         for cb in list(self._on):
             verdict = yield cb(vetted)
@@ -447,10 +447,6 @@ class ParameterStore:
 
 def _is_value_msg(value: Any) -> bool:
     return getattr(value, "__msgtype__", None) == "rcl_interfaces/msg/ParameterValue"
-
-
-def _fail(result: SetParametersResult) -> SetParametersResult:
-    return result
 
 
 def _check_list(params: Iterable[Parameter]) -> list[Parameter]:

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ._errors import ParameterNotDeclaredError, ParameterUninitializedError
-from ._parameters import Parameter, SetParametersResult
-from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from .._errors import ParameterNotDeclaredError, ParameterUninitializedError
+from .._parameters import Parameter, SetParametersResult
+from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 if TYPE_CHECKING:
-    from ._node import Node
+    from .._node import Node
 
 __all__ = ["SERVICE_NAMES", "ParameterEventPublisher", "create_parameter_services", "qos_profile_parameter_events"]
 
@@ -41,7 +41,7 @@ class ParameterEventPublisher:
     """Publishes a ``rcl_interfaces/msg/ParameterEvent`` for every declare, set and undeclare."""
 
     def __init__(self, node: Node) -> None:
-        from .msgs.rcl_interfaces import ParameterEvent
+        from ..msgs.rcl_interfaces import ParameterEvent
 
         self._node = node
         self._event_type = ParameterEvent
@@ -64,7 +64,7 @@ class ParameterEventPublisher:
 
 def create_parameter_services(node: Node) -> list[Any]:
     """Create the six parameter services of ``node`` (rclpy's ``ParameterService``)."""
-    from .msgs import rcl_interfaces as ri
+    from ..msgs import rcl_interfaces as ri
 
     handlers = _Handlers(node)
     return [
@@ -77,7 +77,7 @@ class _Handlers:
     """rclpy's answers: an unknown name empties the whole answer; sets never raise."""
 
     def __init__(self, node: Node) -> None:
-        from .msgs import rcl_interfaces as ri
+        from ..msgs import rcl_interfaces as ri
 
         self.node = node
         self.ri = ri
