@@ -51,4 +51,5 @@ def resolve_node_arguments(
     merged.update(args.parameters_for(name))
     quiet = set(merged) - set(overrides)
     merged.update(overrides)
-    return NodeArguments(merged, remaps, quiet, args.log_level)
+    level = args.log_levels.get(final_name, args.log_levels.get(fqn, args.log_level))  # --log-level name:=level
+    return NodeArguments(merged, remaps, quiet, level)

@@ -124,3 +124,15 @@ def test_aiorobot_run_bad_node_arguments_are_one_line(tmp_path, args, message):
     done = _run(tmp_path, *args)
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and message in done.stderr, done.stderr
+
+
+def test_log_level_for_one_logger_applies_to_that_node():
+    node = Node("talker", cli_args=["--ros-args", "--log-level", "info", "--log-level", "talker:=debug"])
+    other = Node("listener", cli_args=["--ros-args", "--log-level", "info", "--log-level", "talker:=debug"])
+    assert node.get_logger().get_effective_level() == 10
+    assert other.get_logger().get_effective_level() == 20
+
+
+def test_ros_args_with_a_config_file_is_refused(tmp_path):
+    done = _run(tmp_path, "graph.toml", "--ros-args", "-p", "a:=1")
+    assert done.returncode == 2 and "--ros-args needs a module:Class, not a config file" in done.stderr
