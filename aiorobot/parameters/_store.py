@@ -139,6 +139,10 @@ class ParameterStore:
             if given is None:
                 d.description = description
                 d.read_only = read_only
+            elif description or read_only:
+                raise TypeError(
+                    f"parameter {name!r}: give either a descriptor or the description/read_only keywords, not both"
+                )
             if len(entry) == 1 or (second is None and given is None):
                 d.dynamic_typing = True  # name only: rclpy's (deprecated) dynamically typed declaration
             value: Any = None

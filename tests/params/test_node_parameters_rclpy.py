@@ -337,6 +337,8 @@ def test_create_rate_checks_its_frequency():
         node.create_rate(None)  # type: ignore[arg-type]
     with pytest.raises(ValueError):
         node.create_rate(0.0)
+    with pytest.raises(ValueError):
+        node.create_rate(-1.0)
 
 
 def test_declare_parameters_typed_overrides_and_partial_failures():
@@ -502,3 +504,11 @@ def test_static_dynamic_typing():
     assert result.reason.startswith("Wrong parameter type")
     assert node.set_parameters_atomically([Parameter("dynamic_param", value=None), Parameter("int_param", value=4)]).successful
     assert node.get_parameter("int_param").value == 4 and not node.has_parameter("dynamic_param")
+
+
+def test_descriptor_and_shorthand_keywords_do_not_mix():
+    node = Node("n")
+    with pytest.raises(TypeError, match="either a descriptor or the description/read_only keywords"):
+        node.declare_parameter("a", 1, ParameterDescriptor(), description="both")
+    d = node.describe_parameter(node.declare_parameter("b", 2.0, description="m/s", read_only=True, range=(0, 5)).name)
+    assert (d.description, d.read_only, d.floating_point_range[0]) == ("m/s", True, FloatingPointRange(0.0, 5.0, 0.0))
