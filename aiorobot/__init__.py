@@ -16,6 +16,11 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 _EXPORTS = {
+    "ParameterUninitializedError": "_errors",
+    "ParameterImmutableError": "_errors",
+    "InvalidParameterTypeError": "_errors",
+    "IntegerRange": "_parameters",
+    "FloatingPointRange": "_parameters",
     "ActionClient": "_actions",
     "ActionServer": "_actions",
     "CallbackGroup": "_groups",
@@ -25,6 +30,12 @@ _EXPORTS = {
     "Clock": "_clock",
     "ClockPublisher": "_clock_publisher",
     "ClockType": "_time",
+    "ClockChange": "_clock",
+    "Infinite": "_time",
+    "JumpHandle": "_clock",
+    "JumpThreshold": "_clock",
+    "ROSClock": "_clock",
+    "TimeJump": "_clock",
     "ConfigError": "_config",
     "DurabilityPolicy": "_qos",
     "Duration": "_time",
@@ -75,6 +86,11 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "ParameterUninitializedError",
+    "ParameterImmutableError",
+    "InvalidParameterTypeError",
+    "IntegerRange",
+    "FloatingPointRange",
     "ActionClient",
     "ActionServer",
     "CallbackGroup",
@@ -84,6 +100,7 @@ __all__ = [
     "Clock",
     "ClockPublisher",
     "ClockType",
+    "ClockChange",
     "ConfigError",
     "DurabilityPolicy",
     "Duration",
@@ -94,7 +111,10 @@ __all__ = [
     "GraphConfig",
     "HistoryPolicy",
     "InvalidNameError",
+    "Infinite",
     "InvalidParameterValueError",
+    "JumpHandle",
+    "JumpThreshold",
     "LocalTransport",
     "MessageStream",
     "MutuallyExclusiveCallbackGroup",
@@ -110,6 +130,7 @@ __all__ = [
     "Publisher",
     "QoSIncompatibleError",
     "QoSProfile",
+    "ROSClock",
     "Rate",
     "ReentrantCallbackGroup",
     "ReliabilityPolicy",
@@ -122,6 +143,7 @@ __all__ = [
     "SetParametersResult",
     "Subscription",
     "Time",
+    "TimeJump",
     "Timer",
     "TimerStatistics",
     "TopicInfo",
@@ -135,26 +157,27 @@ __all__ = [
 
 if TYPE_CHECKING:
     from ._actions import ActionClient, ActionServer, CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
-    from ._clock import Clock
+    from ._clock import Clock, ClockChange, JumpHandle, JumpThreshold, ROSClock, TimeJump
     from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
+    from ._errors import InvalidParameterTypeError, ParameterImmutableError, ParameterUninitializedError
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
     from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
     from ._logging import NodeLogger, setup_logging
     from ._node import Node
-    from ._parameters import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
+    from ._parameters import FloatingPointRange, IntegerRange, Parameter, ParameterDescriptor, ParameterType, SetParametersResult
     from ._pubsub import MessageStream, Publisher, Subscription
     from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default
     from ._runtime import Runtime, run
     from ._services import Client, Service, ServiceUnavailableError
-    from ._time import ClockType, Duration, Time
+    from ._time import ClockType, Duration, Infinite, Time
     from ._timer import Rate, Timer, TimerStatistics
     from ._transport import LocalTransport, Transport
 
 
 _SUBPACKAGES = frozenset(
-    {"control", "fusion", "lifecycle", "message_filters", "msgs", "perception", "testing", "tf"}
+    {"control", "fusion", "lifecycle", "message_filters", "msgs", "parameters", "perception", "testing", "tf"}
 )
 
 

@@ -55,8 +55,9 @@ _RUNTIME_KEYS = (
     "log_level",
     "priority_realtime",
     "debug_messages",
+    "parameters_file",
 )
-_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level")
+_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file")
 _RECORD_KEYS = ("path",)
 _TOP_KEYS = ("runtime", "nodes", "record")
 
@@ -106,6 +107,7 @@ class RuntimeConfig:
     log_level: str = "info"
     priority_realtime: bool = False
     debug_messages: bool = False
+    parameters_file: str | None = None  # a ROS 2 YAML parameter file for every node (absolute path)
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,6 +127,7 @@ class NodeConfig:
     parameters: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     remap: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     log_level: str | None = None
+    parameters_file: str | None = None  # this node's ROS 2 YAML parameter file (absolute path)
 
     @property
     def key(self) -> str:
@@ -243,7 +246,10 @@ def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
     checker.check_type(realtime, "runtime.priority_realtime", bool, "true or false")
     debug_messages = table.get("debug_messages", False)
     checker.check_type(debug_messages, "runtime.debug_messages", bool, "true or false")
-    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages)
+    parameters_file = _parameters_file(checker, table, "runtime")
+    return RuntimeConfig(
+        transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file
+    )
 
 
 def _parse_nodes(checker: _Checker, data: Mapping[str, Any]) -> tuple[NodeConfig, ...]:
@@ -330,7 +336,26 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
         parameters=MappingProxyType(flat),
         remap=MappingProxyType(dict(remap)),
         log_level=log_level,
+        parameters_file=_parameters_file(checker, table, key),
     )
+
+
+def _parameters_file(checker: _Checker, table: Mapping[str, Any], key: str) -> str | None:
+    """``parameters_file = "params.yaml"`` (relative to the config file): exists and parses."""
+    from .parameters._files import ParameterFileError, load_parameter_file
+
+    if "parameters_file" not in table:
+        return None
+    value = table["parameters_file"]
+    checker.check_type(value, f"{key}.parameters_file", str, "a path to a ROS 2 YAML parameter file")
+    path = Path(value) if Path(value).is_absolute() else Path(checker.path).resolve().parent / value
+    try:
+        load_parameter_file(path)
+    except FileNotFoundError:
+        raise checker.error(f"{key}.parameters_file", f"expected an existing file, found no {str(path)!r}") from None
+    except ParameterFileError as err:
+        raise checker.error(f"{key}.parameters_file", str(err)) from None
+    return str(path)
 
 
 def _flatten_parameters(

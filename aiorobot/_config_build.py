@@ -147,6 +147,9 @@ def _construct(config: GraphConfig, node_config: NodeConfig) -> Node:
     remappings.update(node_config.remap)
     if remappings:
         kwargs["remappings"] = remappings
+    files = [f for f in (config.runtime.parameters_file, node_config.parameters_file) if f]
+    if files:  # sections matched to the node's name, under the inline parameters
+        kwargs["cli_args"] = ["--ros-args", *(arg for f in files for arg in ("--params-file", f))]
     _check_signature(config, node_config, cls, kwargs)
     try:
         node = cls(**kwargs)

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 __all__ = [
     "InvalidNameError",
+    "InvalidParameterTypeError",
     "InvalidParameterValueError",
     "ParameterAlreadyDeclaredError",
     "ParameterError",
+    "ParameterImmutableError",
     "ParameterNotDeclaredError",
+    "ParameterUninitializedError",
     "QoSIncompatibleError",
     "ServiceError",
 ]
@@ -56,6 +59,25 @@ class InvalidParameterValueError(ParameterError):
         self.name = name
         self.reason = reason
         super().__init__(f"parameter {name!r}: {reason}")
+
+
+class InvalidParameterTypeError(InvalidParameterValueError):
+    """A value's type does not match the parameter's declared (static) type (rclpy's
+    ``InvalidParameterTypeException``).
+
+    rclpy difference: it is also an :class:`InvalidParameterValueError`, so code that
+    catches bad values catches bad types too; the rclpy exception is unrelated to
+    ``InvalidParameterValueException``.
+    """
+
+
+class ParameterImmutableError(ParameterError):
+    """A read-only parameter was undeclared or re-described (rclpy's ``ParameterImmutableException``)."""
+
+
+class ParameterUninitializedError(ParameterError):
+    """A parameter declared with a type but no value was read before it got one
+    (rclpy's ``ParameterUninitializedException``)."""
 
 
 class ServiceError(RuntimeError):

@@ -14,7 +14,7 @@ import asyncio
 import functools
 import inspect
 import threading
-from collections.abc import Awaitable, Callable, Mapping
+from collections.abc import Awaitable, Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ._actions import ActionClient, ActionServer
@@ -24,7 +24,7 @@ from ._logging import NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
 from ._node_graph import NodeGraphMixin
 from ._node_parameters import NodeParametersMixin
-from ._parameters import ParameterStore
+from .parameters._store import ParameterStore
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile
 from ._services import Client, Service
@@ -55,6 +55,17 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     remappings
         Topic and service remappings (``{"/cmd_vel": "/base/cmd_vel"}``), plus the
         special keys ``__node`` and ``__ns`` as in ROS 2.
+    cli_args
+        ROS arguments as rclpy's: ``["--ros-args", "-p", "rate:=5", "-r", "/a:=/b",
+        "--params-file", "f.yaml"]``; file sections match this node's fully qualified name.
+    allow_undeclared_parameters, automatically_declare_parameters_from_overrides, start_parameter_services
+        As in rclpy: setting undeclared parameters declares them (dynamically typed);
+        every override is declared at construction; the ``~/get_parameters`` family of
+        services is created. ``/parameter_events`` is always published.
+
+    rclpy difference: the ``use_sim_time`` parameter, when nothing sets it, follows
+    ``Runtime(use_sim_time=...)`` instead of defaulting to false, so one runtime flag
+    switches every node; ``parameter_overrides`` also takes a ``{name: value}`` mapping.
     """
 
     def __init__(
@@ -62,10 +73,19 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         name: str,
         *,
         namespace: str = "",
-        parameter_overrides: Mapping[str, Any] | None = None,
+        parameter_overrides: Mapping[str, Any] | Iterable[Any] | None = None,
         remappings: Mapping[str, str] | None = None,
+        allow_undeclared_parameters: bool = False,
+        automatically_declare_parameters_from_overrides: bool = False,
+        start_parameter_services: bool = True,
+        cli_args: Sequence[str] | None = None,
     ) -> None:
-        remaps = dict(remappings or {})
+        from ._node_arguments import resolve_node_arguments
+
+        arguments = resolve_node_arguments(
+            name, namespace, _overrides_dict(parameter_overrides), dict(remappings or {}), cli_args
+        )
+        remaps = arguments.remappings
         for key, value in remaps.items():
             if not isinstance(key, str) or not isinstance(value, str):
                 raise TypeError(f"remappings: expected str -> str, found {key!r} -> {value!r}")
@@ -73,8 +93,12 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._namespace = validate_namespace(remaps.get("__ns", namespace))
         self._remappings = remaps
         self._fqn = join_fqn(self._namespace, self._name)
-        self._parameters = ParameterStore(self._fqn, dict(parameter_overrides or {}))
+        self._parameters = ParameterStore(
+            self._fqn, arguments.overrides, allow_undeclared=allow_undeclared_parameters, quiet=arguments.quiet
+        )
         self._logger = NodeLogger(self._fqn)
+        if arguments.log_level is not None:
+            self._logger.set_level(arguments.log_level)
         self._default_group = MutuallyExclusiveCallbackGroup()
         self._publishers: list[Publisher[Any]] = []
         self._subscriptions: list[Subscription[Any]] = []
@@ -90,6 +114,21 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._waker: LoopWaker | TimerFdWaker | None = None
         self._clock: Clock = Clock()
         self._started = False
+        self._setup_parameters(automatically_declare_parameters_from_overrides, start_parameter_services)
+
+    def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
+        """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
+        from .parameters._services import ParameterEventPublisher, create_parameter_services
+        from ._time_source import TimeSource
+
+        self._parameters.event_hook = ParameterEventPublisher(self)
+        if auto_declare:
+            overrides = self._parameters.overrides
+            self.declare_parameters("", [(n, v) for n, v in overrides.items()], ignore_override=True)
+            self._parameters._claimed.update(overrides)
+        self._time_source = TimeSource(self)
+        if start_services:
+            create_parameter_services(self)
 
     def __repr__(self) -> str:
         where = f" on {self._executor}" if self._executor else " (not added)"
@@ -211,6 +250,10 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         return timer
 
     def create_rate(self, frequency: float) -> Rate:
+        """A :class:`Rate` of ``frequency`` Hz on this node's clock; ``TypeError`` for a non-number
+        (``create_rate(None)``) and ``ValueError`` for one <= 0, as rclpy."""
+        if isinstance(frequency, bool) or not isinstance(frequency, (int, float)):
+            raise TypeError(f"create_rate: expected a frequency in Hz (a number), found {frequency!r}")
         return Rate(self, frequency)
 
     def destroy_publisher(self, pub: Publisher[Any]) -> None:
@@ -388,8 +431,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._loop = loop
         self._thread_id = thread_id
         self._waker = waker
-        self._clock = runtime.clock
-        self._logger._bind_clock(runtime.clock)
+        self._clock = self._time_source.clock_for(runtime)
+        self._logger._bind_clock(self._clock)
         for timer in self._timers:
             if not timer._cancelled:
                 timer._anchor()
@@ -536,6 +579,22 @@ def _describe(entity: Any) -> str:
     if isinstance(entity, Timer):
         return f"timer {entity.period_ns / 1e9:g}s"
     return repr(entity)
+
+
+def _overrides_dict(overrides: Mapping[str, Any] | Iterable[Any] | None) -> dict[str, Any]:
+    """Overrides as ``{name: value}``: a mapping, or rclpy's list of ``Parameter``."""
+    if overrides is None:
+        return {}
+    if isinstance(overrides, Mapping):
+        return dict(overrides)
+    from ._parameters import Parameter
+
+    out = {}
+    for p in overrides:
+        if not isinstance(p, Parameter):
+            raise TypeError(f"parameter_overrides: expected a mapping or a list of Parameter, found {p!r}")
+        out[p.name] = p.value
+    return out
 
 
 def _check_msg_type(msg_type: Any) -> None:

@@ -1,37 +1,41 @@
-"""Node parameters with ROS 2 semantics: declared, typed, ranged, read-only, vetted by callbacks.
+"""Parameter values as rclpy has them: ``Parameter``, its ``Type``, descriptors, ranges, and the
+conversions to and from ``rcl_interfaces`` messages.
 
-A parameter's type is fixed by its default (or by its first value when declared
-without one); an int is accepted where a double is declared, as TOML users
-expect. A rejected value (wrong type, out of range, read-only, refused by a
-callback) leaves the old value in place and the result says why.
+The node-side rules (declaration, overrides, callbacks, events) live in
+:mod:`aiorobot.parameters._store`.
 """
 
 from __future__ import annotations
 
+import array
 import enum
-import inspect
 import math
-from collections.abc import Awaitable, Callable, Generator, Iterable, Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from ._errors import (
-    InvalidParameterValueError,
-    ParameterAlreadyDeclaredError,
-    ParameterNotDeclaredError,
-)
-
 __all__ = [
+    "FloatingPointRange",
+    "IntegerRange",
     "Parameter",
     "ParameterDescriptor",
-    "ParameterStore",
     "ParameterType",
     "SetParametersResult",
+    "get_parameter_value",
+    "parameter_value_to_python",
 ]
+
+#: rclpy's ``PARAMETER_SEPARATOR_STRING``
+SEPARATOR = "."
 
 
 class ParameterType(enum.IntEnum):
-    """Values as ``rcl_interfaces/msg/ParameterType``."""
+    """Values as ``rcl_interfaces/msg/ParameterType``; also ``Parameter.Type``.
+
+    rclpy difference: ``bytes`` is a BYTE_ARRAY value, a list mixing ints and floats is a
+    DOUBLE_ARRAY (rclpy raises ``TypeError``), and an empty list fits any array type (rclpy
+    calls it a BYTE_ARRAY, so it cannot be set on a string-array parameter).
+    """
 
     NOT_SET = 0
     BOOL = 1
@@ -45,8 +49,12 @@ class ParameterType(enum.IntEnum):
     STRING_ARRAY = 9
 
     @classmethod
-    def of(cls, value: Any) -> ParameterType:
-        """The type of a Python value, or raise TypeError for unsupported values."""
+    def from_parameter_value(cls, value: Any) -> ParameterType:
+        """The type of a Python value (rclpy's rules), or ``TypeError`` for unsupported values.
+
+        A list of ``bytes`` is a BYTE_ARRAY (so is ``bytes``); an empty list is a
+        BYTE_ARRAY as in rclpy, and is accepted for any array parameter.
+        """
         if value is None:
             return cls.NOT_SET
         if isinstance(value, bool):
@@ -59,275 +67,343 @@ class ParameterType(enum.IntEnum):
             return cls.STRING
         if isinstance(value, (bytes, bytearray)):
             return cls.BYTE_ARRAY
-        if isinstance(value, (list, tuple)):
-            if not value:
-                raise TypeError("an empty list has no element type; give a typed default")
-            kinds = {cls.of(v) for v in value}
-            if kinds == {cls.BOOL}:
+        if hasattr(value, "tolist") and not isinstance(value, array.array):  # numpy arrays and scalars
+            return cls.from_parameter_value(value.tolist())
+        if isinstance(value, (list, tuple, array.array)):
+            if all(isinstance(v, bytes) for v in value):
+                return cls.BYTE_ARRAY
+            if all(isinstance(v, bool) for v in value):
                 return cls.BOOL_ARRAY
-            if kinds == {cls.INTEGER}:
+            if all(isinstance(v, int) and not isinstance(v, bool) for v in value):
                 return cls.INTEGER_ARRAY
-            if kinds <= {cls.INTEGER, cls.DOUBLE}:
+            if all(isinstance(v, float) for v in value):
                 return cls.DOUBLE_ARRAY
-            if kinds == {cls.STRING}:
+            if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+                return cls.DOUBLE_ARRAY  # [1, 2.5]: what a TOML or YAML user means
+            if all(isinstance(v, str) for v in value):
                 return cls.STRING_ARRAY
-            raise TypeError(f"a list parameter must hold one type, found {sorted(k.name for k in kinds)}")
-        if hasattr(value, "tolist"):  # numpy arrays and scalars
-            return cls.of(value.tolist())
+            raise TypeError(f"a list parameter must hold one type (bool, int, float, str or bytes), found {value!r}")
         raise TypeError(
             f"unsupported parameter value {value!r} of type {type(value).__name__} "
-            "(bool, int, float, str, bytes or a list of one of them)"
+            "(bool, int, float, str, or a list of bytes, bool, int, float or str)"
+        )
+
+    #: aiorobot's shorter name for :meth:`from_parameter_value`
+    of = from_parameter_value
+
+    def check(self, value: Any) -> bool:
+        """Whether ``value`` is of this type, as rclpy's ``Parameter.Type.check``."""
+        try:
+            found = ParameterType.from_parameter_value(value)
+        except TypeError:
+            return False
+        return found is self or (
+            isinstance(value, (list, tuple)) and not value and self >= ParameterType.BYTE_ARRAY
         )
 
 
-def _coerce(ptype: ParameterType, value: Any) -> Any:
-    """Convert ``value`` to ``ptype`` where that loses nothing (int -> double); else TypeError."""
-    found = ParameterType.of(value)
+def _normalise(ptype: ParameterType, value: Any) -> Any:
+    """The stored form: lists for arrays (BYTE_ARRAY as a list of one-byte ``bytes``), plain scalars."""
+    if ptype is ParameterType.BYTE_ARRAY:
+        if isinstance(value, (bytes, bytearray)):
+            return [bytes([b]) for b in value]
+        return [bytes(v) for v in value]
+    if ptype is ParameterType.DOUBLE_ARRAY:
+        return [float(v) for v in (value.tolist() if hasattr(value, "tolist") else value)]
+    if ptype >= ParameterType.BOOL_ARRAY:
+        return list(value.tolist() if hasattr(value, "tolist") else value)
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return value
+
+
+def coerce(ptype: ParameterType, value: Any) -> Any:
+    """``value`` as a value of ``ptype`` where that loses nothing (int -> double); else ``TypeError``."""
+    found = ParameterType.from_parameter_value(value)
     if found is ptype:
-        if ptype in (ParameterType.BOOL_ARRAY, ParameterType.INTEGER_ARRAY, ParameterType.STRING_ARRAY):
-            return list(value)
-        if ptype is ParameterType.DOUBLE_ARRAY:
-            return [float(v) for v in value]
-        if ptype is ParameterType.BYTE_ARRAY:
-            return bytes(value)
-        return value.tolist() if hasattr(value, "tolist") else value
+        return _normalise(ptype, value)
     if ptype is ParameterType.DOUBLE and found is ParameterType.INTEGER:
         return float(value)
     if ptype is ParameterType.DOUBLE_ARRAY and found is ParameterType.INTEGER_ARRAY:
         return [float(v) for v in value]
+    if ptype >= ParameterType.BYTE_ARRAY and isinstance(value, (list, tuple)) and not value:
+        return []
     raise TypeError(f"expected {ptype.name.lower()}, found {found.name.lower()} {value!r}")
 
 
-@dataclass(frozen=True, slots=True)
 class Parameter:
-    """A parameter name and value; the type follows from the value."""
+    """A parameter name, type and value, as rclpy's ``Parameter``.
 
-    name: str
-    value: Any = None
+    ``Parameter(name, Parameter.Type.INTEGER, 42)``, ``Parameter(name, value=42)`` and
+    ``Parameter(name)`` (NOT_SET) work as in rclpy: a value that disagrees with the given
+    type raises ``ValueError``, an unsupported value ``TypeError``.
+
+    rclpy difference: ``Parameter(name, 42)`` (a second argument that is not a
+    ``Parameter.Type``, and no third) means ``value=42``, aiorobot's two-argument form;
+    rclpy raises ``TypeError`` there.
+    """
+
+    __slots__ = ("_name", "_type", "_value")
+
+    Type = ParameterType
+
+    def __init__(self, name: str, type_: Any = None, value: Any = None) -> None:
+        if type_ is not None and not isinstance(type_, ParameterType):
+            if value is not None:
+                raise TypeError(f"type_: expected a Parameter.Type, found {type_!r}")
+            type_, value = None, type_  # aiorobot's Parameter(name, value)
+        if type_ is None:
+            type_ = ParameterType.from_parameter_value(value)
+        elif not type_.check(value):
+            raise ValueError(f"type {type_.name} and value {value!r} do not agree (parameter {name!r})")
+        self._name = name
+        self._type = type_
+        self._value = value
+
+    @property
+    def name(self) -> str:
+        return self._name
 
     @property
     def type_(self) -> ParameterType:
-        return ParameterType.of(self.value)
+        return self._type
+
+    @property
+    def value(self) -> Any:
+        return self._value
+
+    def __repr__(self) -> str:
+        return f"Parameter({self._name!r}, {self._type.name}, {self._value!r})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Parameter):
+            return NotImplemented
+        return (self._name, self._type, self._value) == (other._name, other._type, other._value)
+
+    __hash__ = None  # type: ignore[assignment]  # values may be lists
+
+    def get_parameter_value(self) -> Any:
+        """This value as an ``rcl_interfaces/msg/ParameterValue``."""
+        return to_parameter_value(self._type, self._value)
+
+    def to_parameter_msg(self) -> Any:
+        """This parameter as an ``rcl_interfaces/msg/Parameter``."""
+        from .msgs.rcl_interfaces import Parameter as ParameterMsg
+
+        return ParameterMsg(name=self._name, value=self.get_parameter_value())
+
+    @classmethod
+    def from_parameter_msg(cls, msg: Any) -> Parameter:
+        """From an ``rcl_interfaces/msg/Parameter``."""
+        value = parameter_value_to_python(msg.value)
+        return cls(msg.name, ParameterType(msg.value.type), value)
+
+
+_FIELDS = {
+    ParameterType.BOOL: "bool_value",
+    ParameterType.INTEGER: "integer_value",
+    ParameterType.DOUBLE: "double_value",
+    ParameterType.STRING: "string_value",
+    ParameterType.BYTE_ARRAY: "byte_array_value",
+    ParameterType.BOOL_ARRAY: "bool_array_value",
+    ParameterType.INTEGER_ARRAY: "integer_array_value",
+    ParameterType.DOUBLE_ARRAY: "double_array_value",
+    ParameterType.STRING_ARRAY: "string_array_value",
+}
+
+
+def to_parameter_value(ptype: ParameterType, value: Any) -> Any:
+    """``value`` of ``ptype`` as an ``rcl_interfaces/msg/ParameterValue``."""
+    from .msgs.rcl_interfaces import ParameterValue
+
+    if ptype is ParameterType.NOT_SET:
+        return ParameterValue(type=0)
+    if ptype is ParameterType.BYTE_ARRAY:
+        value = list(b"".join(_normalise(ptype, value)))
+    elif ptype >= ParameterType.BOOL_ARRAY:
+        value = _normalise(ptype, value)
+    return ParameterValue(type=int(ptype), **{_FIELDS[ptype]: value})
+
+
+def parameter_value_to_python(parameter_value: Any) -> Any:
+    """The Python value of an ``rcl_interfaces/msg/ParameterValue`` (``None`` for NOT_SET).
+
+    Raises ``RuntimeError`` for an unknown ``type``, as rclpy.
+    """
+    try:
+        ptype = ParameterType(parameter_value.type)
+    except ValueError:
+        raise RuntimeError(f"unexpected parameter type {parameter_value.type}") from None
+    if ptype is ParameterType.NOT_SET:
+        return None
+    value = getattr(parameter_value, _FIELDS[ptype])
+    if ptype is ParameterType.BYTE_ARRAY:
+        return [bytes([int(b)]) for b in value]
+    if ptype >= ParameterType.BOOL_ARRAY:
+        return list(value.tolist() if hasattr(value, "tolist") else value)
+    return value.item() if hasattr(value, "item") else value
+
+
+def get_parameter_value(string_value: str) -> Any:
+    """Guess a ``ParameterValue`` from text, as rclpy's (and ``ros2 param set``/``-p name:=value``):
+    YAML scalars and flow lists keep their type, anything else is a string."""
+    import yaml
+
+    try:
+        loaded = yaml.safe_load(string_value)
+    except yaml.YAMLError:
+        loaded = string_value
+    if isinstance(loaded, (bool, int, float)):
+        return to_parameter_value(ParameterType.from_parameter_value(loaded), loaded)
+    if isinstance(loaded, list):
+        if not loaded:
+            return to_parameter_value(ParameterType.BOOL_ARRAY, [])  # rclpy: all() of nothing is true
+        try:
+            ptype = ParameterType.from_parameter_value(loaded)
+        except TypeError:
+            ptype = ParameterType.STRING
+        if ptype in (
+            ParameterType.BOOL_ARRAY,
+            ParameterType.INTEGER_ARRAY,
+            ParameterType.DOUBLE_ARRAY,
+            ParameterType.STRING_ARRAY,
+        ):
+            if ptype is ParameterType.DOUBLE_ARRAY and not all(isinstance(v, float) for v in loaded):
+                ptype = ParameterType.STRING  # rclpy: a mixed int/float list stays text
+            else:
+                return to_parameter_value(ptype, loaded)
+        return to_parameter_value(ParameterType.STRING, string_value)
+    text = loaded if isinstance(loaded, str) else string_value
+    return to_parameter_value(ParameterType.STRING, text)
 
 
 @dataclass(frozen=True, slots=True)
 class SetParametersResult:
+    """The outcome of setting parameters: ``successful`` and, when not, the ``reason``."""
+
     successful: bool
     reason: str = ""
 
 
 @dataclass(frozen=True, slots=True)
-class ParameterDescriptor:
-    """What a node says about one parameter: type, description, limits."""
+class IntegerRange:
+    """Allowed integers: ``from_value`` to ``to_value`` inclusive, on multiples of ``step`` (0: any)."""
 
-    name: str
-    type: ParameterType
+    from_value: int
+    to_value: int
+    step: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class FloatingPointRange:
+    """Allowed doubles: ``from_value`` to ``to_value`` inclusive, on multiples of ``step`` (0: any)."""
+
+    from_value: float
+    to_value: float
+    step: float = 0.0
+
+
+#: rclpy's tolerance for floating-point range edges and steps
+PARAM_REL_TOL = 1e-6
+
+
+@dataclass(slots=True)
+class ParameterDescriptor:
+    """What a node says about one parameter, as ``rcl_interfaces/msg/ParameterDescriptor``.
+
+    ``range`` is aiorobot's shorthand, ``(from, to)`` or ``(from, to, step)``; a declaration
+    turns it into ``integer_range`` or ``floating_point_range`` by the parameter's type.
+    """
+
+    name: str = ""
+    type: ParameterType = ParameterType.NOT_SET
     description: str = ""
     read_only: bool = False
-    range: tuple[float, float, float] | None = None  # (from, to, step); step 0 = any value
+    range: tuple[float, float, float] | None = None
+    additional_constraints: str = ""
+    dynamic_typing: bool = False
+    integer_range: Sequence[Any] = field(default_factory=tuple)
+    floating_point_range: Sequence[Any] = field(default_factory=tuple)
+
+    @classmethod
+    def from_msg(cls, msg: Any) -> ParameterDescriptor:
+        """From an ``rcl_interfaces/msg/ParameterDescriptor``."""
+        return cls(
+            name=msg.name,
+            type=ParameterType(msg.type),
+            description=msg.description,
+            read_only=bool(msg.read_only),
+            additional_constraints=msg.additional_constraints,
+            dynamic_typing=bool(msg.dynamic_typing),
+            integer_range=tuple(IntegerRange(int(r.from_value), int(r.to_value), int(r.step)) for r in msg.integer_range),
+            floating_point_range=tuple(
+                FloatingPointRange(float(r.from_value), float(r.to_value), float(r.step)) for r in msg.floating_point_range
+            ),
+        )
+
+    def to_msg(self) -> Any:
+        """As an ``rcl_interfaces/msg/ParameterDescriptor``."""
+        from .msgs import rcl_interfaces as ri
+
+        return ri.ParameterDescriptor(
+            name=self.name,
+            type=int(self.type),
+            description=self.description,
+            additional_constraints=self.additional_constraints,
+            read_only=self.read_only,
+            dynamic_typing=self.dynamic_typing,
+            integer_range=[
+                ri.IntegerRange(from_value=int(r.from_value), to_value=int(r.to_value), step=int(r.step))
+                for r in self.integer_range
+            ],
+            floating_point_range=[
+                ri.FloatingPointRange(from_value=float(r.from_value), to_value=float(r.to_value), step=float(r.step))
+                for r in self.floating_point_range
+            ],
+        )
 
     def check_range(self, value: Any) -> str | None:
-        if self.range is None or self.type not in (ParameterType.INTEGER, ParameterType.DOUBLE):
+        """Why ``value`` lies outside this descriptor's range, or ``None`` (rclpy's edge and step rules)."""
+        if self.type is ParameterType.INTEGER and self.integer_range and isinstance(value, int):
+            r = self.integer_range[0]
+            lo, hi = min(r.from_value, r.to_value), max(r.from_value, r.to_value)
+            if value in (lo, hi):
+                return None
+            if not lo < value < hi:
+                return f"value {value!r} is outside the range [{lo}, {hi}]"
+            if r.step and (value - lo) % r.step:
+                return f"value {value!r} is not {lo} plus a multiple of the step {r.step}"
             return None
-        lo, hi, step = self.range
-        if not (lo <= value <= hi) and not (
-            self.type is ParameterType.DOUBLE and (math.isclose(value, lo) or math.isclose(value, hi))
-        ):
-            return f"value {value!r} is outside the range [{lo}, {hi}]"
-        if step:
-            n = (value - lo) / step
-            if value != hi and not math.isclose(n, round(n), abs_tol=1e-9):
-                return f"value {value!r} is not {lo} plus a multiple of the step {step}"
+        if self.type is ParameterType.DOUBLE and self.floating_point_range and isinstance(value, float):
+            r = self.floating_point_range[0]
+            lo, hi = min(r.from_value, r.to_value), max(r.from_value, r.to_value)
+            if math.isclose(value, lo, rel_tol=PARAM_REL_TOL) or math.isclose(value, hi, rel_tol=PARAM_REL_TOL):
+                return None
+            if not lo < value < hi:
+                return f"value {value!r} is outside the range [{lo}, {hi}]"
+            if r.step:
+                steps = round((value - lo) / r.step)
+                if not math.isclose(lo + steps * r.step, value, rel_tol=PARAM_REL_TOL):
+                    return f"value {value!r} is not {lo} plus a multiple of the step {r.step}"
         return None
 
 
-OnSetCallback = Callable[[list[Parameter]], "SetParametersResult | Awaitable[SetParametersResult]"]
-
-
-@dataclass
-class _Entry:
-    descriptor: ParameterDescriptor
-    value: Any
-
-
-@dataclass
-class ParameterStore:
-    """The parameters of one node. ``owner`` names the node in messages."""
-
-    owner: str
-    overrides: Mapping[str, Any] = field(default_factory=dict)
-    _entries: dict[str, _Entry] = field(default_factory=dict)
-    _callbacks: list[OnSetCallback] = field(default_factory=list)
-    _claimed: set[str] = field(default_factory=set)
-
-    def declare(
-        self,
-        name: str,
-        default: Any = None,
-        *,
-        description: str = "",
-        read_only: bool = False,
-        range: Sequence[float] | None = None,
-    ) -> Parameter:
-        if not isinstance(name, str) or not name:
-            raise InvalidParameterValueError(str(name), "a parameter name must be a non-empty str")
-        if name in self._entries:
-            raise ParameterAlreadyDeclaredError(f"parameter {name!r} of {self.owner} is already declared")
-        try:
-            ptype = ParameterType.of(default)
-        except TypeError as err:
-            raise InvalidParameterValueError(name, f"bad default: {err}") from None
-        value = default
-        if name in self.overrides:
-            self._claimed.add(name)
-            override = self.overrides[name]
-            if ptype is ParameterType.NOT_SET:
-                try:
-                    ptype = ParameterType.of(override)
-                except TypeError as err:
-                    raise InvalidParameterValueError(name, str(err)) from None
-            try:
-                value = _coerce(ptype, override)
-            except TypeError as err:
-                raise InvalidParameterValueError(name, str(err)) from None
-        elif ptype is not ParameterType.NOT_SET:
-            value = _coerce(ptype, default)
-        descriptor = ParameterDescriptor(
-            name=name,
-            type=ptype,
-            description=description,
-            read_only=read_only,
-            range=_check_range_spec(name, range, ptype),
+def as_descriptor(descriptor: Any) -> ParameterDescriptor:
+    """A copy of ``descriptor`` (ours or an ``rcl_interfaces`` message); ``TypeError`` otherwise."""
+    if descriptor is None:
+        return ParameterDescriptor()
+    if isinstance(descriptor, ParameterDescriptor):
+        return ParameterDescriptor(
+            descriptor.name,
+            ParameterType(descriptor.type),
+            descriptor.description,
+            descriptor.read_only,
+            descriptor.range,
+            descriptor.additional_constraints,
+            descriptor.dynamic_typing,
+            tuple(descriptor.integer_range),
+            tuple(descriptor.floating_point_range),
         )
-        if value is not None:
-            problem = descriptor.check_range(value)
-            if problem:
-                raise InvalidParameterValueError(name, problem)
-        self._entries[name] = _Entry(descriptor, value)
-        return Parameter(name, value)
-
-    def unclaimed_overrides(self) -> list[str]:
-        return sorted(set(self.overrides) - self._claimed)
-
-    def has(self, name: str) -> bool:
-        return name in self._entries
-
-    def names(self) -> list[str]:
-        return sorted(self._entries)
-
-    def get(self, name: str) -> Parameter:
-        entry = self._entries.get(name)
-        if entry is None:
-            raise ParameterNotDeclaredError(
-                f"parameter {name!r} is not declared by {self.owner}"
-                f" (declared: {', '.join(self.names()) or 'none'})"
-            )
-        return Parameter(name, entry.value)
-
-    def describe(self, name: str) -> ParameterDescriptor:
-        self.get(name)
-        return self._entries[name].descriptor
-
-    def add_callback(self, callback: OnSetCallback) -> OnSetCallback:
-        self._callbacks.append(callback)
-        return callback
-
-    def remove_callback(self, callback: OnSetCallback) -> None:
-        self._callbacks.remove(callback)
-
-    def _vet(self, param: Parameter) -> tuple[SetParametersResult, Any]:
-        entry = self._entries.get(param.name)
-        if entry is None:
-            return SetParametersResult(False, f"parameter {param.name!r} is not declared"), None
-        d = entry.descriptor
-        if d.read_only:
-            return SetParametersResult(False, f"parameter {param.name!r} is read-only"), None
-        ptype = d.type if d.type is not ParameterType.NOT_SET else None
-        try:
-            value = _coerce(ptype, param.value) if ptype is not None else param.value
-            if ptype is None:
-                ParameterType.of(value)
-        except TypeError as err:
-            return SetParametersResult(False, f"parameter {param.name!r}: {err}"), None
-        problem = d.check_range(value)
-        if problem:
-            return SetParametersResult(False, f"parameter {param.name!r}: {problem}"), None
-        return SetParametersResult(True), value
-
-    def _commit(self, name: str, value: Any) -> None:
-        entry = self._entries[name]
-        if entry.descriptor.type is ParameterType.NOT_SET and value is not None:
-            entry.descriptor = _replace_type(entry.descriptor, ParameterType.of(value))
-        entry.value = value
-
-    def _set_steps(self, params: Iterable[Parameter]) -> Generator[Any, SetParametersResult, list[SetParametersResult]]:
-        """Set each parameter on its own; yields each callback's verdict and is sent it back resolved."""
-        results = []
-        for param in params:
-            result, value = self._vet(param)
-            if result.successful:
-                for cb in self._callbacks:
-                    verdict = yield cb([Parameter(param.name, value)])
-                    if not verdict.successful:
-                        result = SetParametersResult(False, verdict.reason or "rejected by a callback")
-                        break
-            if result.successful:
-                self._commit(param.name, value)
-            results.append(result)
-        return results
-
-    def set(self, params: Iterable[Parameter]) -> list[SetParametersResult]:
-        """Set each parameter on its own (not atomically), as ``rclpy.Node.set_parameters``."""
-        steps = self._set_steps(params)
-        try:
-            verdict = next(steps)
-            while True:
-                if inspect.isawaitable(verdict):
-                    _close(verdict)
-                    steps.close()
-                    raise TypeError(
-                        "an async on-set-parameters callback is registered: "
-                        "use `await node.set_parameters_async(...)`"
-                    )
-                verdict = steps.send(verdict)
-        except StopIteration as done:
-            return done.value
-
-    async def set_async(self, params: Iterable[Parameter]) -> list[SetParametersResult]:
-        """Like :meth:`set`, awaiting async callbacks."""
-        steps = self._set_steps(params)
-        try:
-            verdict = next(steps)
-            while True:
-                verdict = steps.send(await verdict if inspect.isawaitable(verdict) else verdict)
-        except StopIteration as done:
-            return done.value
-
-
-def _close(awaitable: Any) -> None:
-    close = getattr(awaitable, "close", None)
-    if close is not None:
-        close()
-
-
-def _replace_type(d: ParameterDescriptor, ptype: ParameterType) -> ParameterDescriptor:
-    return ParameterDescriptor(d.name, ptype, d.description, d.read_only, d.range)
-
-
-def _check_range_spec(
-    name: str, spec: Sequence[float] | None, ptype: ParameterType
-) -> tuple[float, float, float] | None:
-    if spec is None:
-        return None
-    if ptype not in (ParameterType.INTEGER, ParameterType.DOUBLE):
-        raise InvalidParameterValueError(name, f"a range needs an integer or double parameter, not {ptype.name.lower()}")
-    values = tuple(spec)
-    if len(values) not in (2, 3) or not all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) for v in values
-    ):
-        raise InvalidParameterValueError(name, f"range: expected (from, to) or (from, to, step), found {spec!r}")
-    lo, hi = values[0], values[1]
-    step = values[2] if len(values) == 3 else 0
-    if lo > hi or step < 0:
-        raise InvalidParameterValueError(name, f"range: expected from <= to and step >= 0, found {spec!r}")
-    return (lo, hi, step)
+    if getattr(descriptor, "__msgtype__", None) == "rcl_interfaces/msg/ParameterDescriptor":
+        return ParameterDescriptor.from_msg(descriptor)
+    raise TypeError(f"descriptor: expected a ParameterDescriptor, found {descriptor!r}")

@@ -48,6 +48,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="SEC",
         help="stop after this many seconds (default: run until Ctrl-C or SIGTERM)",
     )
+    parser.add_argument(  # `aiorobot run module:Class --ros-args ...`: see _run_node
+        "--ros-args", dest="ros_args", nargs=argparse.REMAINDER, metavar="ARGS",
+        help="with module:Class instead of a file: run that one node with ROS 2 arguments "
+        "(-p name:=value, -r from:=to, --params-file FILE, --log-level LEVEL), as ros2 run",
+    )
     parser.add_argument(
         "--status-period",
         type=positive_seconds,
@@ -60,6 +65,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from aiorobot._config import ConfigError, load_config
 
+    from ._run_node import is_node_spec, run_node
+
+    if args.config is not None and is_node_spec(str(args.config)):
+        return run_node(args)
+    if args.ros_args is not None:
+        print("aiorobot run: error: --ros-args needs a module:Class, not a config file", file=sys.stderr)
+        return EXIT_CONFIG_ERROR
     if args.config is None:
         from aiorobot.examples import DEFAULT_CONFIG
 

@@ -65,6 +65,10 @@ class LifecycleNode(Node):
     """
 
     def __init__(self, name: str, *, enable_communication_interface: bool = True, **kwargs: Any) -> None:
+        if not isinstance(enable_communication_interface, bool):
+            raise TypeError(
+                f"enable_communication_interface: expected True or False, found {enable_communication_interface!r}"
+            )
         super().__init__(name, **kwargs)
         self._machine = LifecycleStateMachine(self.get_fully_qualified_name())
         self._lifecycle_publishers: list[LifecyclePublisher[Any]] = []

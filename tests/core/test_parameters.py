@@ -61,7 +61,7 @@ def test_declaring_twice_raises():
 def test_undeclared_parameter_raises_naming_the_declared_ones():
     node = Node("n")
     node.declare_parameter("a", 1)
-    with pytest.raises(ParameterNotDeclaredError, match=r"'b' is not declared by /n \(declared: a\)"):
+    with pytest.raises(ParameterNotDeclaredError, match=r"'b' is not declared by /n \(declared: a, use_sim_time\)"):
         node.get_parameter("b")
 
 
@@ -92,9 +92,14 @@ def test_one_result_per_parameter_applied_individually():
     node = Node("n")
     node.declare_parameter("a", 1)
     node.declare_parameter("b", "x")
-    results = node.set_parameters([Parameter("a", 2), Parameter("b", 3), Parameter("c", 1)])
-    assert [r.successful for r in results] == [True, False, False]
+    results = node.set_parameters([Parameter("a", 2), Parameter("b", 3)])
+    assert [r.successful for r in results] == [True, False]
     assert node.get_parameter("a").value == 2 and node.get_parameter("b").value == "x"
+    # rclpy test_node.py::test_node_set_undeclared_parameters: an undeclared name raises,
+    # after the parameters before it are applied
+    with pytest.raises(ParameterNotDeclaredError, match="'c' not declared by /n"):
+        node.set_parameters([Parameter("a", 3), Parameter("c", 1), Parameter("a", 4)])
+    assert node.get_parameter("a").value == 3
 
 
 def test_callback_can_reject_and_the_value_stays():
