@@ -130,10 +130,19 @@ class TimeCache:
     # -- updates -------------------------------------------------------------------
 
     def insert(self, stamp: int, sample: Sample) -> bool:
-        """Insert a sample; False (and no change) when it is older than the cache length."""
+        """Insert a sample; False (and no change) when it is older than the cache length.
+
+        As tf2's ``TimeCache::insertData`` (Jazzy): the cache is pruned *before*
+        the insert, against the newest stamp held so far, so a sample older than
+        the cache length survives until the next insert and interpolation just
+        inside the boundary still works. An exact duplicate is not stored twice.
+        """
         stamps = self.stamps
-        if stamps and stamp < stamps[-1] - self._max_ns:
-            return False
+        if stamps:
+            latest = stamps[-1]
+            self._prune(latest)
+            if stamp < latest - self._max_ns:
+                return False
         i = bisect_right(stamps, stamp)
         j = i
         while j > 0 and stamps[j - 1] == stamp:
@@ -142,12 +151,12 @@ class TimeCache:
                 return True  # exact duplicate: nothing to do
         stamps.insert(i, stamp)
         self.samples.insert(i, sample)
-        self._prune()
         return True
 
-    def _prune(self) -> None:
+    def _prune(self, latest: int) -> None:
+        """Drop samples older than ``latest`` minus the cache length (tf2's ``pruneList``)."""
         stamps = self.stamps
-        k = bisect_left(stamps, stamps[-1] - self._max_ns)
+        k = bisect_left(stamps, latest - self._max_ns)
         if k:
             del stamps[:k]
             del self.samples[:k]
