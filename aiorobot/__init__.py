@@ -29,6 +29,7 @@ _EXPORTS = {
     "DurabilityPolicy": "_qos",
     "Duration": "_time",
     "EndpointInfo": "_graph",
+    "Future": "_future",
     "GoalResponse": "_actions",
     "GoalStatus": "_actions",
     "Graph": "_graph",
@@ -88,6 +89,7 @@ __all__ = [
     "DurabilityPolicy",
     "Duration",
     "EndpointInfo",
+    "Future",
     "GoalResponse",
     "GoalStatus",
     "Graph",
@@ -139,6 +141,7 @@ if TYPE_CHECKING:
     from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
+    from ._future import Future
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
     from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
     from ._logging import NodeLogger, setup_logging

@@ -252,13 +252,15 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self,
         srv_type: Any,
         name: str,
-        handler: Callable[[Any], Any],
+        handler: Callable[..., Any],
         *,
         callback_group: CallbackGroup | None = None,
     ) -> Service:
         """Serve ``name`` with ``handler(request) -> response`` (async or sync).
 
-        A handler that raises answers the caller with :class:`ServiceError` carrying the reason.
+        rclpy's ``handler(request, response) -> response`` form works too (a handler
+        taking two positional arguments gets a fresh ``Response``). A handler that
+        raises answers the caller with :class:`ServiceError` carrying the reason.
         """
         service = Service(
             self, srv_type, self.resolve_topic_name(name, kind="service"), handler, callback_group or self._default_group
@@ -270,9 +272,18 @@ class Node(NodeParametersMixin, NodeGraphMixin):
                 self._call_soon(service._start)
         return service
 
-    def create_client(self, srv_type: Any, name: str) -> Client:
-        """A client of ``name``: ``await client.wait_for_service()``, ``await client.call(request)``."""
-        client = Client(self, srv_type, self.resolve_topic_name(name, kind="service"))
+    def create_client(
+        self, srv_type: Any, name: str, *, callback_group: CallbackGroup | None = None
+    ) -> Client:
+        """A client of ``name``: ``await client.wait_for_service()``, ``await client.call(request)``.
+
+        ``client.call_async(request)`` returns an rclpy-style future. ``callback_group``
+        is kept on the client as in rclpy; responses complete on the caller's loop,
+        which needs no group to serialise them.
+        """
+        client = Client(
+            self, srv_type, self.resolve_topic_name(name, kind="service"), callback_group or self._default_group
+        )
         self._clients.append(client)
         if self._runtime is not None:
             self._runtime._bus.services.add(client)
