@@ -17,7 +17,7 @@ import threading
 from collections.abc import Awaitable, Callable, Mapping
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ._actions import ActionClient, ActionServer
+from ._actions import DEFAULT_RESULT_TIMEOUT_SEC, ActionClient, ActionServer
 from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 from ._logging import NodeLogger
@@ -296,18 +296,27 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         execute: Callable[[Any], Any],
         *,
         goal_callback: Callable[[Any], Any] | None = None,
+        handle_accepted_callback: Callable[[Any], Any] | None = None,
         cancel_callback: Callable[[Any], Any] | None = None,
         callback_group: CallbackGroup | None = None,
+        result_timeout: float = DEFAULT_RESULT_TIMEOUT_SEC,
     ) -> ActionServer:
-        """Serve action ``name``: ``execute(goal_handle) -> Result`` per accepted goal."""
+        """Serve action ``name``: ``execute(goal_handle) -> Result`` per accepted goal.
+
+        ``handle_accepted_callback(goal_handle)`` replaces the default start (``goal_handle.execute()``)
+        for servers that queue or preempt goals; ``result_timeout`` is how long a finished goal's
+        result is kept, in seconds. See :class:`ActionServer`.
+        """
         return ActionServer(
             self,
             action_type,
             name,
             execute,
             goal_callback=goal_callback,
+            handle_accepted_callback=handle_accepted_callback,
             cancel_callback=cancel_callback,
             callback_group=callback_group,
+            result_timeout=result_timeout,
         )
 
     def create_action_client(self, action_type: Any, name: str) -> ActionClient:
