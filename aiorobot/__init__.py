@@ -42,6 +42,7 @@ _EXPORTS = {
     "MutuallyExclusiveCallbackGroup": "_groups",
     "Node": "_node",
     "NodeInfo": "_graph",
+    "NodeNameNonExistentError": "_node_graph",
     "NodeLogger": "_logging",
     "Parameter": "_parameters",
     "ParameterAlreadyDeclaredError": "_errors",
@@ -102,6 +103,7 @@ __all__ = [
     "MutuallyExclusiveCallbackGroup",
     "Node",
     "NodeInfo",
+    "NodeNameNonExistentError",
     "NodeLogger",
     "Parameter",
     "ParameterAlreadyDeclaredError",
@@ -143,6 +145,7 @@ if TYPE_CHECKING:
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
     from ._future import Future
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
+    from ._node_graph import NodeNameNonExistentError
     from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
     from ._logging import NodeLogger, setup_logging
     from ._node import Node
