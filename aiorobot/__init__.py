@@ -66,6 +66,7 @@ _EXPORTS = {
     "Subscription": "_pubsub",
     "Time": "_time",
     "Timer": "_timer",
+    "TimerInfo": "_timer",
     "TimerStatistics": "_timer",
     "TopicInfo": "_graph",
     "Transport": "_transport",
@@ -127,6 +128,7 @@ __all__ = [
     "Subscription",
     "Time",
     "Timer",
+    "TimerInfo",
     "TimerStatistics",
     "TopicInfo",
     "Transport",
@@ -155,7 +157,7 @@ if TYPE_CHECKING:
     from ._runtime import Runtime, run
     from ._services import Client, Service, ServiceUnavailableError
     from ._time import ClockType, Duration, Time
-    from ._timer import Rate, Timer, TimerStatistics
+    from ._timer import Rate, Timer, TimerInfo, TimerStatistics
     from ._transport import LocalTransport, Transport
 
 

@@ -213,6 +213,10 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     def create_rate(self, frequency: float) -> Rate:
         return Rate(self, frequency)
 
+    def destroy_rate(self, rate: Rate) -> None:
+        """Retire ``rate`` (rclpy's ``destroy_rate``); sleeping on it afterwards raises."""
+        rate.destroy()
+
     def destroy_publisher(self, pub: Publisher[Any]) -> None:
         if pub in self._publishers:
             self._publishers.remove(pub)
