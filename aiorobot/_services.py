@@ -91,6 +91,11 @@ class Service(_ServiceEndpoint):
 
     rclpy's form ``handler(request, response) -> response`` works too: a handler
     taking two positional arguments gets a fresh ``Response`` to fill and return.
+
+    rclpy difference: a handler that raises, or returns something other than the
+    ``Response``, answers the caller with :class:`~aiorobot.ServiceError` carrying
+    the reason; in rclpy the error surfaces in the server's executor and the caller
+    never gets an answer.
     """
 
     kind = "service"

@@ -220,7 +220,13 @@ class Cache(SimpleFilter):
     Every message added is passed on to this filter's callbacks. With
     ``allow_headerless=True`` a message without ``header.stamp`` is stamped with
     the node's clock (or the system time) on arrival; otherwise it is dropped with
-    a warning.
+    a warning. The Python ``message_filters`` names work too (``getInterval``,
+    ``getElemAfterTime``, ``getElemBeforeTime``, ``getLastestTime``,
+    ``getOldestTime``, ``getLast``).
+
+    rclpy difference: messages are kept sorted by stamp and a full cache drops the
+    oldest *stamp* (the Python package keeps arrival order and drops the first to
+    arrive), so out-of-order input is answered correctly, as by the C++ ``Cache``.
     """
 
     def __init__(self, input_filter: SimpleFilter | None = None, cache_size: int = 1, *, allow_headerless: bool = False) -> None:
