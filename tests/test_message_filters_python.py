@@ -11,6 +11,7 @@ from aiorobot.message_filters import (
     ApproximateEpsilonTimePolicy,
     ApproximateTimeSynchronizer,
     Cache,
+    LatestTimePolicy,
     PythonApproximateTimePolicy,
     PythonExactTimePolicy,
     SimpleFilter,
@@ -325,3 +326,145 @@ async def test_time_synchronizer_python_default_pairs_late_older_stamps(runtime)
     await settle(runtime)
     assert got == [2.0, 1.0]
     assert Subscriber(node, PointStamped, "/c").getTopic() == "/c"
+
+
+class FakeClock:
+    def __init__(self):
+        self.ns = 0
+
+    def __call__(self):
+        return self.ns
+
+
+def _latest_run(schedule, steps):
+    """Drive a 3-input LatestTimePolicy: ``schedule(idx)`` lists (input, data) added at step idx (20 ms apart).
+
+    Returns, per step, (count, last output) as message_filters' test_latest_time_policy.cpp checks them.
+    """
+    clock = FakeClock()
+    policy = LatestTimePolicy(3, now_ns=clock)
+    count, last, seen = 0, None, []
+    for idx in range(steps):
+        for index, data in schedule(idx):
+            for out in policy.add(index, 0, data):
+                count += 1
+                last = out
+        seen.append((count, last))
+        clock.ns += 20_000_000
+    return seen
+
+
+def test_latest_time_leading():
+    # message_filters test/test_latest_time_policy.cpp::LatestTimePolicy.Leading
+    def schedule(idx):
+        adds = []
+        if idx % 2 == 0:
+            adds.append((1, ("q", idx // 2 * 2)))
+        if idx % 4 == 0:
+            adds.append((2, ("r", idx // 4 * 4)))
+        adds.append((0, ("p", idx)))
+        return adds
+
+    for idx, (count, last) in enumerate(_latest_run(schedule, 8)):
+        assert count == idx
+        if idx > 0:
+            assert last == (("p", idx), ("q", idx // 2 * 2), ("r", idx // 4 * 4))
+        else:
+            assert last is None
+
+
+def test_latest_time_trailing():
+    # message_filters test/test_latest_time_policy.cpp::LatestTimePolicy.Trailing
+    def schedule(idx):
+        adds = []
+        if idx % 2 == 1:
+            adds.append((1, ("q", (idx - 1) // 2)))
+        if idx % 4 == 3:
+            adds.append((2, ("r", (idx - 3) // 4)))
+        adds.append((0, ("p", idx)))
+        return adds
+
+    for idx, (count, last) in enumerate(_latest_run(schedule, 8)):
+        if idx > 2:
+            assert count == idx - 2
+            assert last == (("p", idx), ("q", (idx - 1) // 2), ("r", (idx - 3) // 4))
+        else:
+            assert last is None
+
+
+def test_latest_time_change_rate_leading():
+    # message_filters test/test_latest_time_policy.cpp::LatestTimePolicy.ChangeRateLeading
+    p_next = iter(range(4, 12))
+
+    def schedule(idx):
+        adds = []
+        if idx % 2 == 0:
+            adds.append((1, ("q", idx // 2)))
+        if idx % 4 == 0:
+            adds.append((2, ("r", idx // 4)))
+        if idx < 4:
+            adds.append((0, ("p", idx)))
+        elif idx % 3 == 0:  # p slows down
+            adds.append((0, ("p", next(p_next))))
+        return adds
+
+    for idx, (count, last) in enumerate(_latest_run(schedule, 12)):
+        if 1 <= idx < 4:
+            assert (count, last) == (idx, (("p", idx), ("q", idx // 2), ("r", idx // 4)))
+        elif 4 <= idx < 6:
+            # p is slower but not yet found late: nothing new until q takes over as pivot at idx 6
+            assert (count, last) == ((idx + 2) // 2, (("p", 3), ("q", 1), ("r", 0)))
+        elif idx >= 6:
+            assert count == (idx + 2) // 2
+            assert last == (("p", idx // 2), ("q", idx // 2), ("r", (idx - 2) // 4))
+        else:
+            assert last is None
+
+
+def test_latest_time_change_rate_trailing():
+    # message_filters test/test_latest_time_policy.cpp::LatestTimePolicy.ChangeRateTrailing
+    p_next = iter(range(4, 12))
+
+    def schedule(idx):
+        adds = []
+        if idx % 2 == 1:
+            adds.append((1, ("q", (idx - 1) // 2)))
+        if idx % 4 == 3:
+            adds.append((2, ("r", (idx - 3) // 4)))
+        if idx < 4:
+            adds.append((0, ("p", idx)))
+        elif idx % 3 == 1:
+            adds.append((0, ("p", next(p_next))))
+        return adds
+
+    for idx, (count, last) in enumerate(_latest_run(schedule, 12)):
+        if 2 < idx <= 4:
+            assert count == idx - 2
+            assert last == (("p", idx), ("q", (idx - 1) // 2), ("r", (idx - 3) // 4))
+        elif 4 < idx < 7:
+            assert (count, last) == (2, (("p", 4), ("q", 1), ("r", 0)))
+        elif idx >= 7:
+            assert count == (idx - 1) // 2
+            assert last == (("p", (idx + 1) // 2), ("q", (idx - 1) // 2), ("r", (idx - 5) // 4))
+        else:
+            assert last is None
+
+
+async def test_latest_time_synchronizer_on_sim_time_with_headerless_messages(sim_runtime, sim_clock):
+    pubs = sim_runtime.add_node(Node("pubs"))
+    node = sim_runtime.add_node(Node("listener"))
+    fast = pubs.create_publisher(String, "/fast", 10)
+    slow = pubs.create_publisher(String, "/slow", 10)
+    sync = Synchronizer(
+        [Subscriber(node, String, "/fast"), Subscriber(node, String, "/slow")], LatestTimePolicy(2)
+    )
+    got = []
+    sync.registerCallback(lambda f, s: got.append((f.data, s.data)))
+    for k in range(8):
+        if k % 4 == 0:
+            slow.publish(String(data=f"s{k}"))  # leading the fast one, as in the Leading test
+            await settle(sim_runtime)
+        fast.publish(String(data=f"f{k}"))
+        await settle(sim_runtime)
+        await sim_clock.advance(0.01)
+    assert got == [(f"f{k}", f"s{k // 4 * 4}") for k in range(1, 8)]  # the slow one is held

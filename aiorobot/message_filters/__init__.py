@@ -13,7 +13,8 @@ selects the C++ policies (the optimal ``ApproximateTime``, ``ExactTime``).
 The policies are plain classes usable without a runtime
 (:class:`PythonExactTimePolicy`, :class:`PythonApproximateTimePolicy`,
 :class:`ExactTimePolicy`, :class:`ApproximateTimePolicy`,
-:class:`ApproximateEpsilonTimePolicy`); :class:`Synchronizer` runs any of them.
+:class:`ApproximateEpsilonTimePolicy`, :class:`LatestTimePolicy`); :class:`Synchronizer`
+runs any of them.
 :class:`Cache` keeps a stamp-ordered history of an input.
 """
 
@@ -21,7 +22,12 @@ from __future__ import annotations
 
 from ._filters import Cache, Connection, SimpleFilter, Subscriber
 from ._policies import ApproximateTimePolicy, ExactTimePolicy
-from ._py_policies import ApproximateEpsilonTimePolicy, PythonApproximateTimePolicy, PythonExactTimePolicy
+from ._py_policies import (
+    ApproximateEpsilonTimePolicy,
+    LatestTimePolicy,
+    PythonApproximateTimePolicy,
+    PythonExactTimePolicy,
+)
 from ._sync import ApproximateTimeSynchronizer, Synchronizer, TimeSynchronizer
 
 __all__ = [
@@ -31,6 +37,7 @@ __all__ = [
     "Cache",
     "Connection",
     "ExactTimePolicy",
+    "LatestTimePolicy",
     "PythonApproximateTimePolicy",
     "PythonExactTimePolicy",
     "SimpleFilter",

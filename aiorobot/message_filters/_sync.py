@@ -37,7 +37,9 @@ class Synchronizer(SimpleFilter):
     ``policy`` is any object with ``add(index, stamp_ns, message) -> list of sets``:
     :class:`PythonExactTimePolicy`, :class:`PythonApproximateTimePolicy`,
     :class:`ExactTimePolicy`, :class:`ApproximateTimePolicy`,
-    :class:`ApproximateEpsilonTimePolicy` or your own. :class:`TimeSynchronizer`
+    :class:`ApproximateEpsilonTimePolicy`, :class:`LatestTimePolicy` or your own.
+    A policy with ``needs_stamps = False`` takes messages without headers; one
+    with ``now_ns = None`` gets the node clock. :class:`TimeSynchronizer`
     and :class:`ApproximateTimeSynchronizer` are this with the policy chosen for you.
     """
 
@@ -55,6 +57,9 @@ class Synchronizer(SimpleFilter):
         super().__init__(node)
         self.inputs = inputs
         self.policy = policy
+        self._needs_stamps = getattr(policy, "needs_stamps", True)
+        if hasattr(policy, "now_ns") and policy.now_ns is None:
+            policy.now_ns = functools.partial(_now_ns, self)  # arrival times on the node clock
         self.allow_headerless = allow_headerless
         self._lock = threading.Lock()  # inputs may live on different loops
         self._warned_headerless = False
@@ -68,7 +73,7 @@ class Synchronizer(SimpleFilter):
 
         Returns an awaitable that finishes the ``async def`` callbacks, if any.
         """
-        stamp = stamp_ns_of(msg)
+        stamp = stamp_ns_of(msg) if self._needs_stamps else 0
         if stamp is None:
             if not self.allow_headerless:
                 if not self._warned_headerless:
