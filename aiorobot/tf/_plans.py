@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from math import sin
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ._math import IDENTITY_QUAT, Quat, Vec, _qinv, _qmul, _qrot
 
@@ -32,7 +32,15 @@ FULL_PATH = 2
 
 _ZERO: Vec = (0.0, 0.0, 0.0)
 
-Link = tuple["TimeCache | StaticCache", int]
+#: (cache, expected parent, and for a TimeCache its stamps, samples and interval lists -- the very
+#: lists the cache mutates in place, held here to spare the attribute lookups on every replay)
+Link = tuple[Any, int, Any, Any, Any]
+
+
+def _link(cache: TimeCache | StaticCache, parent: int) -> Link:
+    if cache.is_static:
+        return (cache, parent, None, None, None)
+    return (cache, parent, cache.stamps, cache.samples, cache._intervals)  # type: ignore[union-attr]
 
 
 class ChainPlan:
@@ -67,8 +75,8 @@ def trace_plan(
         if st is None or st[0] == 0:
             return None  # the full walk decides (extrapolation, maybe a path from the target)
         if frame == target_id:
-            return ChainPlan(TARGET_IS_ANCESTOR, source_links, [], (cache, st[0]))
-        source_links.append((cache, st[0]))
+            return ChainPlan(TARGET_IS_ANCESTOR, source_links, [], _link(cache, st[0]))
+        source_links.append(_link(cache, st[0]))
         top_parent = frame
         frame = st[0]
         depth += 1
@@ -85,13 +93,13 @@ def trace_plan(
         if st is None or st[0] == 0:
             return None
         if frame == source_id:
-            return ChainPlan(SOURCE_IS_ANCESTOR, [], target_links, (cache, st[0]))
-        target_links.append((cache, st[0]))
+            return ChainPlan(SOURCE_IS_ANCESTOR, [], target_links, _link(cache, st[0]))
+        target_links.append(_link(cache, st[0]))
         frame = st[0]
         depth += 1
         if depth > max_depth:
             return None
-    return ChainPlan(FULL_PATH, source_links, target_links, (None, 0))  # type: ignore[arg-type]
+    return ChainPlan(FULL_PATH, source_links, target_links, (None, 0, None, None, None))
 
 
 def _accumulate(links: list[Link], t: int) -> tuple[Vec, Quat] | None:
@@ -106,17 +114,16 @@ def _accumulate(links: list[Link], t: int) -> tuple[Vec, Quat] | None:
     vx = vy = vz = 0.0
     rx = ry = rz = 0.0
     rw = 1.0
-    for cache, parent in links:
+    first = True
+    for cache, parent, stamps, samples, intervals in links:
         st: Sample | None = None
-        if cache.is_static:
-            st = cache.sample  # type: ignore[union-attr]
+        if stamps is None:
+            st = cache.sample  # static
         else:
-            stamps = cache.stamps  # type: ignore[union-attr]
             if len(stamps) < 2 or t > stamps[-1] or t < stamps[0]:
                 st, _ = cache.get_data(t)  # edges, single samples, errors: the general path
             else:
                 i = bisect_right(stamps, t) - 1
-                samples = cache.samples  # type: ignore[union-attr]
                 st = samples[i]
                 t0 = stamps[i]
                 if t0 != t and st[0] == samples[i + 1][0]:
@@ -124,9 +131,7 @@ def _accumulate(links: list[Link], t: int) -> tuple[Vec, Quat] | None:
                     if st[0] != parent:
                         return None
                     nw = samples[i + 1]
-                    theta, qx, qy, qz, qw, bx, by, bz, bw = (
-                        cache._intervals.get(i) or cache.interval(i)  # type: ignore[union-attr]
-                    )
+                    theta, qx, qy, qz, qw, bx, by, bz, bw = intervals.get(i) or cache.interval(i)
                     ratio = (t - t0) / (stamps[i + 1] - t0)
                     keep = 1.0 - ratio
                     if theta != 0.0:
@@ -142,6 +147,10 @@ def _accumulate(links: list[Link], t: int) -> tuple[Vec, Quat] | None:
             if st is None or st[0] != parent:
                 return None
             _, px, py, pz, qx, qy, qz, qw = st
+        if first:  # composed with the identity: the link itself
+            vx, vy, vz, rx, ry, rz, rw = px, py, pz, qx, qy, qz, qw
+            first = False
+            continue
         # vec = q * vec * q^-1 + p, as v + w t + u x t with t = 2 u x v (u the vector part of q)
         tx = 2.0 * (qy * vz - qz * vy)
         ty = 2.0 * (qz * vx - qx * vz)
@@ -165,7 +174,7 @@ def walk_plan(plan: ChainPlan, t: int) -> tuple[Vec, Quat] | None:
     """Replay ``plan`` at time ``t``: source2target as ``_walk`` computes it, or ``None`` to fall back."""
     kind = plan.kind
     if kind != FULL_PATH:
-        cache, parent = plan.check
+        cache, parent = plan.check[0], plan.check[1]
         st, _ = cache.get_data(t)
         if st is None or st[0] != parent:
             return None
