@@ -40,6 +40,7 @@ _EXPORTS = {
     "DurabilityPolicy": "_qos",
     "Duration": "_time",
     "EndpointInfo": "_graph",
+    "Future": "_future",
     "GoalResponse": "_actions",
     "GoalStatus": "_actions",
     "Graph": "_graph",
@@ -52,6 +53,7 @@ _EXPORTS = {
     "MutuallyExclusiveCallbackGroup": "_groups",
     "Node": "_node",
     "NodeInfo": "_graph",
+    "NodeNameNonExistentError": "_node_graph",
     "NodeLogger": "_logging",
     "Parameter": "_parameters",
     "ParameterAlreadyDeclaredError": "_errors",
@@ -75,6 +77,7 @@ _EXPORTS = {
     "Subscription": "_pubsub",
     "Time": "_time",
     "Timer": "_timer",
+    "TimerInfo": "_timer",
     "TimerStatistics": "_timer",
     "TopicInfo": "_graph",
     "Transport": "_transport",
@@ -105,6 +108,7 @@ __all__ = [
     "DurabilityPolicy",
     "Duration",
     "EndpointInfo",
+    "Future",
     "GoalResponse",
     "GoalStatus",
     "Graph",
@@ -120,6 +124,7 @@ __all__ = [
     "MutuallyExclusiveCallbackGroup",
     "Node",
     "NodeInfo",
+    "NodeNameNonExistentError",
     "NodeLogger",
     "Parameter",
     "ParameterAlreadyDeclaredError",
@@ -145,6 +150,7 @@ __all__ = [
     "Time",
     "TimeJump",
     "Timer",
+    "TimerInfo",
     "TimerStatistics",
     "TopicInfo",
     "Transport",
@@ -162,7 +168,9 @@ if TYPE_CHECKING:
     from ._config import ConfigError, GraphConfig, load_config
     from ._errors import InvalidParameterTypeError, ParameterImmutableError, ParameterUninitializedError
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
+    from ._future import Future
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
+    from ._node_graph import NodeNameNonExistentError
     from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
     from ._logging import NodeLogger, setup_logging
     from ._node import Node
@@ -172,7 +180,7 @@ if TYPE_CHECKING:
     from ._runtime import Runtime, run
     from ._services import Client, Service, ServiceUnavailableError
     from ._time import ClockType, Duration, Infinite, Time
-    from ._timer import Rate, Timer, TimerStatistics
+    from ._timer import Rate, Timer, TimerInfo, TimerStatistics
     from ._transport import LocalTransport, Transport
 
 

@@ -19,6 +19,7 @@ from collections import deque
 from collections.abc import AsyncIterator, Callable
 from typing import TYPE_CHECKING, Any
 
+from ._future import Future, future_of
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ._qos import DurabilityPolicy, QoSProfile
 from ._services import ServiceUnavailableError
@@ -40,6 +41,8 @@ STATUS_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
 FEEDBACK_QOS = QoSProfile(depth=10)
 #: Finished goals whose results a server keeps for late ``get_result`` calls.
 MAX_KEPT_RESULTS = 256
+#: How long a server keeps a finished goal's result (rclpy's ``result_timeout`` default).
+DEFAULT_RESULT_TIMEOUT_SEC = 10.0
 
 
 class GoalStatus(enum.IntEnum):
@@ -124,6 +127,25 @@ class ServerGoalHandle:
     def is_cancel_requested(self) -> bool:
         return self._status is GoalStatus.CANCELING
 
+    def execute(self, execute_callback: Callable[[ServerGoalHandle], Any] | None = None) -> None:
+        """Start executing this goal: ``EXECUTING``, then ``execute_callback`` (default: the server's).
+
+        What the default ``handle_accepted_callback`` does at once; a server that
+        queues or preempts goals calls it later (as rclpy's ``goal_handle.execute()``).
+        A goal whose cancel was requested meanwhile stays ``CANCELING`` and the
+        callback still runs, to end it with ``canceled()``.
+        """
+        if not self.is_active:
+            raise RuntimeError(f"{self!r} is finished; it cannot be executed")
+        if self._task is not None:
+            raise RuntimeError(f"{self!r} is already executing; execute() runs a goal once")
+        if self._status is GoalStatus.ACCEPTED:
+            self._status = GoalStatus.EXECUTING
+            self._server._publish_status()
+        server = self._server
+        callback = execute_callback or server._execute
+        self._task = server.node._create_task(server._run_goal(self, callback), name=f"goal {_gid_str(self.goal_id)}")
+
     def publish_feedback(self, feedback: Any) -> None:
         action = self._server.action_type
         if not isinstance(feedback, action.Feedback):
@@ -139,6 +161,10 @@ class ServerGoalHandle:
             )
         self._status = status
         self._server._publish_status()
+        if status.is_terminal and self._task is None:
+            # ended before it ever executed (a queue or preemption server dropping it): its
+            # result is the empty Result, so get_result answers instead of waiting forever
+            self._server._finish(self, self._server.action_type.Result())
 
     def succeed(self) -> None:
         self._transition(GoalStatus.SUCCEEDED, (GoalStatus.EXECUTING, GoalStatus.CANCELING))
@@ -165,6 +191,20 @@ class ActionServer:
     ``execute`` that raises aborts that goal only. Goals run concurrently; by default
     they hold no callback-group lock, so a long goal never blocks the node's other
     callbacks (pass ``callback_group`` to serialise them).
+
+    ``handle_accepted_callback(goal_handle)`` is called with each accepted goal once
+    the client has its answer; the default calls ``goal_handle.execute()`` at once.
+    A server that queues goals, or preempts the running one, passes its own and
+    calls ``execute()`` later (rclpy's pattern, as in ros2/examples). A finished
+    goal's result is kept for ``result_timeout`` seconds (node clock) for late
+    ``get_result`` requests, then forgotten (its status becomes UNKNOWN).
+
+    rclpy difference: ``execute`` holds no callback-group lock unless
+    ``callback_group`` is given (rclpy runs it in the server's group, by default
+    the node's mutually exclusive one, so one long goal blocks every other
+    callback of the node); and a goal ended before it executed (aborted or
+    canceled while queued) answers ``get_result`` with the empty ``Result`` where
+    rclpy never answers.
     """
 
     def __init__(
@@ -175,12 +215,18 @@ class ActionServer:
         execute: Callable[[ServerGoalHandle], Any],
         *,
         goal_callback: Callable[[Any], Any] | None = None,
+        handle_accepted_callback: Callable[[ServerGoalHandle], Any] | None = None,
         cancel_callback: Callable[[ServerGoalHandle], Any] | None = None,
         callback_group: CallbackGroup | None = None,
+        result_timeout: float = DEFAULT_RESULT_TIMEOUT_SEC,
     ) -> None:
         _check_action_type(action_type)
         if not callable(execute):
             raise TypeError(f"execute must be callable, got {execute!r}")
+        if handle_accepted_callback is not None and not callable(handle_accepted_callback):
+            raise TypeError(f"handle_accepted_callback must be callable, got {handle_accepted_callback!r}")
+        if isinstance(result_timeout, bool) or not isinstance(result_timeout, (int, float)) or not result_timeout >= 0:
+            raise ValueError(f"result_timeout: expected a number of seconds >= 0, got {result_timeout!r}")
         from .msgs.action_msgs import CancelGoal, GoalStatusArray
 
         self.node = node
@@ -188,7 +234,9 @@ class ActionServer:
         self.name = node.resolve_topic_name(name, kind="action")
         self._execute = execute
         self._goal_callback = goal_callback
+        self._handle_accepted_callback = handle_accepted_callback
         self._cancel_callback = cancel_callback
+        self.result_timeout = float(result_timeout)
         self._group = callback_group
         self._goals: dict[bytes, ServerGoalHandle] = {}
         self._finished: deque[bytes] = deque()
@@ -231,22 +279,35 @@ class ActionServer:
         handle = ServerGoalHandle(self, request.goal_id, request.goal, stamp)
         self._goals[gid] = handle
         self._publish_status()
-        handle._task = self.node._create_task(self._run_goal(handle), name=f"goal {_gid_str(request.goal_id)}")
+        if self._handle_accepted_callback is None:
+            handle.execute()
+        else:
+            # after this handler returns, so the client has its answer first (as rclpy)
+            self.node._create_task(self._accepted(handle), name=f"goal {_gid_str(request.goal_id)} accepted")
         return action.SendGoal.Response(accepted=True, stamp=stamp)
 
-    async def _run_goal(self, handle: ServerGoalHandle) -> None:
+    async def _accepted(self, handle: ServerGoalHandle) -> None:
+        assert self._handle_accepted_callback is not None
+        try:
+            await _maybe_await(self._handle_accepted_callback(handle))
+        except Exception:
+            self.node.get_logger().error(
+                f"handle_accepted_callback of action {self.name} raised; goal {_gid_str(handle.goal_id)} aborted",
+                exc_info=True,
+            )
+            if handle.is_active:
+                handle.abort()
+
+    async def _run_goal(self, handle: ServerGoalHandle, execute: Callable[[ServerGoalHandle], Any]) -> None:
         action = self.action_type
         log = self.node.get_logger()
-        if handle._status is GoalStatus.ACCEPTED:
-            handle._status = GoalStatus.EXECUTING
-            self._publish_status()
         result = None
         try:
             if self._group is not None:
                 async with self._group:
-                    result = await _maybe_await(self._execute(handle))
+                    result = await _maybe_await(execute(handle))
             else:
-                result = await _maybe_await(self._execute(handle))
+                result = await _maybe_await(execute(handle))
         except asyncio.CancelledError:
             if handle.is_active:
                 handle._status = GoalStatus.ABORTED
@@ -270,12 +331,25 @@ class ActionServer:
         self._finish(handle, result)
 
     def _finish(self, handle: ServerGoalHandle, result: Any) -> None:
+        if handle._done.done():
+            return
         handle._result = result
-        if not handle._done.done():
-            handle._done.set_result(None)
-        self._finished.append(_gid(handle.goal_id))
+        handle._done.set_result(None)
+        gid = _gid(handle.goal_id)
+        self._finished.append(gid)
         while len(self._finished) > MAX_KEPT_RESULTS:
             self._goals.pop(self._finished.popleft(), None)
+        self.node._create_task(self._expire(gid, handle), name=f"goal {_gid_str(handle.goal_id)} expiry")
+
+    async def _expire(self, gid: bytes, handle: ServerGoalHandle) -> None:
+        """Forget a finished goal ``result_timeout`` seconds (node clock) after it finished."""
+        never: asyncio.Future[None] = asyncio.get_running_loop().create_future()
+        try:
+            await self.node._wait_with_timeout(never, self.result_timeout)
+        except TimeoutError:
+            if self._goals.get(gid) is handle:
+                del self._goals[gid]
+                self._publish_status()
 
     async def _on_get_result(self, request: Any) -> Any:
         handle = self._goals.get(_gid(request.goal_id))
@@ -403,6 +477,25 @@ class ClientGoalHandle:
             self._result_task = asyncio.ensure_future(self._fetch_result())
         return await self._client.node._wait_with_timeout(asyncio.shield(self._result_task), timeout_sec)
 
+    def get_result_async(self) -> Future[Any]:
+        """rclpy's form: a :class:`~aiorobot.Future` of the ``GetResult`` response (``.status``, ``.result``)."""
+        return future_of(self._result_response(), self._client._loop_for_futures())
+
+    async def _result_response(self) -> Any:
+        result = await self.result()
+        return self._client.action_type.GetResult.Response(status=int(self.status), result=result)
+
+    def cancel_goal_async(self) -> Future[Any]:
+        """rclpy's form: a :class:`~aiorobot.Future` of the ``action_msgs/srv/CancelGoal`` response."""
+        return future_of(self._cancel_response(None), self._client._loop_for_futures())
+
+    async def _cancel_response(self, timeout_sec: float | None) -> Any:
+        from .msgs.action_msgs import CancelGoal, GoalInfo
+
+        return await self._client._cancel_goal.call(
+            CancelGoal.Request(goal_info=GoalInfo(goal_id=self.goal_id)), timeout_sec
+        )
+
     async def _fetch_result(self) -> Any:
         action = self._client.action_type
         response = await self._client._get_result.call(action.GetResult.Request(goal_id=self.goal_id))
@@ -414,11 +507,7 @@ class ClientGoalHandle:
 
     async def cancel(self, timeout_sec: float | None = None) -> bool:
         """Ask the server to cancel; True when it accepted (the goal then ends CANCELED, usually)."""
-        from .msgs.action_msgs import CancelGoal, GoalInfo
-
-        response = await self._client._cancel_goal.call(
-            CancelGoal.Request(goal_info=GoalInfo(goal_id=self.goal_id)), timeout_sec
-        )
+        response = await self._cancel_response(timeout_sec)
         gid = _gid(self.goal_id)
         return response.return_code == _ERROR_NONE and any(_gid(g.goal_id) == gid for g in response.goals_canceling)
 
@@ -479,6 +568,25 @@ class ActionClient:
                 return False
         return True
 
+    def _loop_for_futures(self) -> asyncio.AbstractEventLoop | None:
+        try:
+            asyncio.get_running_loop()
+        except RuntimeError:
+            return self.node._loop
+        return None
+
+    def send_goal_async(
+        self, goal: Any, feedback_callback: Callable[[Any], Any] | None = None
+    ) -> Future[ClientGoalHandle]:
+        """rclpy's form: a :class:`~aiorobot.Future` of the :class:`ClientGoalHandle` (``.accepted``).
+
+        Then ``goal_handle.get_result_async()`` and ``goal_handle.cancel_goal_async()``.
+        """
+        action = self.action_type
+        if not isinstance(goal, action.Goal):
+            raise TypeError(f"send_goal expects {action.Goal.__msgtype__}, got {type(goal).__name__}")
+        return future_of(self.send_goal(goal, feedback_callback), self._loop_for_futures())
+
     async def send_goal(
         self,
         goal: Any,
@@ -490,6 +598,11 @@ class ActionClient:
 
         ``feedback_callback(feedback_message)`` gets each ``FeedbackMessage`` (as in rclpy);
         ``handle.feedback()`` yields the inner ``Feedback`` messages.
+
+        rclpy difference: ``feedback_callback`` may be ``async def``, and each call
+        runs as a task of its own (in a reentrant group), so a slow callback never
+        delays the goal's status, result or the next feedback; rclpy runs it in the
+        action client's callback group.
         """
         from .msgs.unique_identifier_msgs import UUID
 

@@ -17,7 +17,7 @@ import threading
 from collections.abc import Awaitable, Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ._actions import ActionClient, ActionServer
+from ._actions import DEFAULT_RESULT_TIMEOUT_SEC, ActionClient, ActionServer
 from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 from ._logging import NodeLogger
@@ -256,6 +256,10 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             raise TypeError(f"create_rate: expected a frequency in Hz (a number), found {frequency!r}")
         return Rate(self, frequency)
 
+    def destroy_rate(self, rate: Rate) -> None:
+        """Retire ``rate`` (rclpy's ``destroy_rate``); sleeping on it afterwards raises."""
+        rate.destroy()
+
     def destroy_publisher(self, pub: Publisher[Any]) -> None:
         if pub in self._publishers:
             self._publishers.remove(pub)
@@ -295,13 +299,15 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self,
         srv_type: Any,
         name: str,
-        handler: Callable[[Any], Any],
+        handler: Callable[..., Any],
         *,
         callback_group: CallbackGroup | None = None,
     ) -> Service:
         """Serve ``name`` with ``handler(request) -> response`` (async or sync).
 
-        A handler that raises answers the caller with :class:`ServiceError` carrying the reason.
+        rclpy's ``handler(request, response) -> response`` form works too (a handler
+        taking two positional arguments gets a fresh ``Response``). A handler that
+        raises answers the caller with :class:`ServiceError` carrying the reason.
         """
         service = Service(
             self, srv_type, self.resolve_topic_name(name, kind="service"), handler, callback_group or self._default_group
@@ -313,9 +319,18 @@ class Node(NodeParametersMixin, NodeGraphMixin):
                 self._call_soon(service._start)
         return service
 
-    def create_client(self, srv_type: Any, name: str) -> Client:
-        """A client of ``name``: ``await client.wait_for_service()``, ``await client.call(request)``."""
-        client = Client(self, srv_type, self.resolve_topic_name(name, kind="service"))
+    def create_client(
+        self, srv_type: Any, name: str, *, callback_group: CallbackGroup | None = None
+    ) -> Client:
+        """A client of ``name``: ``await client.wait_for_service()``, ``await client.call(request)``.
+
+        ``client.call_async(request)`` returns an rclpy-style future. ``callback_group``
+        is kept on the client as in rclpy; responses complete on the caller's loop,
+        which needs no group to serialise them.
+        """
+        client = Client(
+            self, srv_type, self.resolve_topic_name(name, kind="service"), callback_group or self._default_group
+        )
         self._clients.append(client)
         if self._runtime is not None:
             self._runtime._bus.services.add(client)
@@ -328,18 +343,27 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         execute: Callable[[Any], Any],
         *,
         goal_callback: Callable[[Any], Any] | None = None,
+        handle_accepted_callback: Callable[[Any], Any] | None = None,
         cancel_callback: Callable[[Any], Any] | None = None,
         callback_group: CallbackGroup | None = None,
+        result_timeout: float = DEFAULT_RESULT_TIMEOUT_SEC,
     ) -> ActionServer:
-        """Serve action ``name``: ``execute(goal_handle) -> Result`` per accepted goal."""
+        """Serve action ``name``: ``execute(goal_handle) -> Result`` per accepted goal.
+
+        ``handle_accepted_callback(goal_handle)`` replaces the default start (``goal_handle.execute()``)
+        for servers that queue or preempt goals; ``result_timeout`` is how long a finished goal's
+        result is kept, in seconds. See :class:`ActionServer`.
+        """
         return ActionServer(
             self,
             action_type,
             name,
             execute,
             goal_callback=goal_callback,
+            handle_accepted_callback=handle_accepted_callback,
             cancel_callback=cancel_callback,
             callback_group=callback_group,
+            result_timeout=result_timeout,
         )
 
     def create_action_client(self, action_type: Any, name: str) -> ActionClient:

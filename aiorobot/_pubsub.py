@@ -302,6 +302,19 @@ class Subscription(Endpoint, Generic[M]):
 
         return checked
 
+    def get_publisher_count(self) -> int:
+        """How many publishers this subscription receives from (matched by type and QoS), as rclpy's."""
+        runtime = self.node._runtime
+        if runtime is None:
+            return 0
+        return sum(
+            1
+            for topic in runtime._bus.snapshot()
+            if topic.name == self.topic_name
+            for pub in topic.publishers
+            if self in pub._subs
+        )
+
     def destroy(self) -> None:
         self.node.destroy_subscription(self)
 

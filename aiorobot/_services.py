@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from ._clock import _call_on
 from ._errors import ServiceError
+from ._future import Future, future_of
 
 if TYPE_CHECKING:
     from ._groups import CallbackGroup
@@ -33,6 +34,26 @@ class ServiceUnavailableError(ServiceError):
 
 def _srv_name(srv_type: Any) -> str:
     return str(getattr(srv_type, "__msgtype__", None) or getattr(srv_type, "__name__", repr(srv_type)))
+
+
+def takes_response(handler: Callable[..., Any]) -> bool:
+    """Whether ``handler`` is rclpy's ``cb(request, response)`` form rather than ``cb(request)``.
+
+    Two or more positional parameters without defaults (or ``*args``) mean the
+    two-argument form; a handler whose signature cannot be read is called with one.
+    """
+    try:
+        sig = inspect.signature(handler)
+    except (TypeError, ValueError):
+        return False
+    required = 0
+    for p in sig.parameters.values():
+        if p.kind is inspect.Parameter.VAR_POSITIONAL:
+            return True
+        if p.kind in (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD):
+            if p.default is inspect.Parameter.empty:
+                required += 1
+    return required >= 2
 
 
 def check_srv_type(srv_type: Any) -> None:
@@ -66,7 +87,16 @@ class _ServiceEndpoint:
 
 
 class Service(_ServiceEndpoint):
-    """Answers requests with ``handler(request) -> response``; created by ``Node.create_service``."""
+    """Answers requests with ``handler(request) -> response``; created by ``Node.create_service``.
+
+    rclpy's form ``handler(request, response) -> response`` works too: a handler
+    taking two positional arguments gets a fresh ``Response`` to fill and return.
+
+    rclpy difference: a handler that raises, or returns something other than the
+    ``Response``, answers the caller with :class:`~aiorobot.ServiceError` carrying
+    the reason; in rclpy the error surfaces in the server's executor and the caller
+    never gets an answer.
+    """
 
     kind = "service"
 
@@ -78,6 +108,7 @@ class Service(_ServiceEndpoint):
         self.srv_type = srv_type
         self.srv_name = name
         self.handler = handler
+        self._with_response = takes_response(handler)
         self.callback_group = group
         self._queue: deque[_Call] = deque()
         self._waiter: asyncio.Future[None] | None = None
@@ -135,7 +166,10 @@ class Service(_ServiceEndpoint):
     async def _handle(self, call: _Call) -> None:
         try:
             async with self.callback_group:
-                response = self.handler(call.request)
+                if self._with_response:
+                    response = self.handler(call.request, self.srv_type.Response())
+                else:
+                    response = self.handler(call.request)
                 if inspect.isawaitable(response):
                     response = await response
         except asyncio.CancelledError:
@@ -181,15 +215,25 @@ def _reply(call: _Call, *, result: Any = None, exc: BaseException | None = None)
 
 
 class Client(_ServiceEndpoint):
-    """Calls a service; created by ``Node.create_client``."""
+    """Calls a service; created by ``Node.create_client``.
+
+    ``await client.call(request)`` is the asyncio way; ``client.call_async(request)``
+    returns an rclpy-style :class:`~aiorobot.Future`.
+
+    rclpy difference: a call (``call`` or ``call_async``) when no server offers the
+    service fails at once with :class:`ServiceUnavailableError` instead of waiting
+    unanswered; wait with ``await client.wait_for_service()`` first, as rclpy's
+    examples do.
+    """
 
     kind = "client"
 
-    def __init__(self, node: Node, srv_type: Any, name: str) -> None:
+    def __init__(self, node: Node, srv_type: Any, name: str, callback_group: CallbackGroup | None = None) -> None:
         check_srv_type(srv_type)
         self.node = node
         self.srv_type = srv_type
         self.srv_name = name
+        self.callback_group = callback_group
         self.destroyed = False
         self._pending: set[asyncio.Future[Any]] = set()
 
@@ -215,6 +259,26 @@ class Client(_ServiceEndpoint):
         finally:
             registry.remove_waiter(self.srv_name, fut)
 
+    def _check_request(self, request: Any) -> None:
+        if self.destroyed:
+            raise RuntimeError(f"{self!r} was destroyed")
+        if not isinstance(request, self.srv_type.Request):
+            raise TypeError(
+                f"client of {self.srv_name} expects {_srv_name(self.srv_type.Request)}, got {type(request).__name__}"
+            )
+
+    def call_async(self, request: Any) -> Future[Any]:
+        """Send ``request``; the returned :class:`~aiorobot.Future` completes with the response.
+
+        As rclpy's ``call_async``: ``future.add_done_callback(cb)``, ``future.result()``,
+        ``future.done()``, or ``await future``. The future holds the errors
+        :meth:`call` would raise. ``future.cancel()`` abandons the call (a late
+        reply is dropped). Call it from a callback or coroutine, or once the node
+        runs (then from any thread).
+        """
+        self._check_request(request)
+        return future_of(self.call(request), None if _in_loop() else self.node._loop)
+
     async def call(self, request: Any, timeout_sec: float | None = None) -> Any:
         """Send ``request`` and return the response.
 
@@ -222,12 +286,7 @@ class Client(_ServiceEndpoint):
         :class:`ServiceError` with the server's reason when its handler fails, and
         :class:`ServiceUnavailableError` at once when no server offers the service.
         """
-        if self.destroyed:
-            raise RuntimeError(f"{self!r} was destroyed")
-        if not isinstance(request, self.srv_type.Request):
-            raise TypeError(
-                f"client of {self.srv_name} expects {_srv_name(self.srv_type.Request)}, got {type(request).__name__}"
-            )
+        self._check_request(request)
         servers = self._registry().servers(self.srv_name, self.type_name)
         if not servers:
             raise ServiceUnavailableError(
@@ -252,6 +311,14 @@ class Client(_ServiceEndpoint):
 
     def destroy(self) -> None:
         self.node.destroy_client(self)
+
+
+def _in_loop() -> bool:
+    try:
+        asyncio.get_running_loop()
+    except RuntimeError:
+        return False
+    return True
 
 
 @dataclass

@@ -12,6 +12,8 @@ as ROS 2 does.
 from __future__ import annotations
 
 import asyncio
+import functools
+import inspect
 import time
 from collections import deque
 from collections.abc import Callable
@@ -19,12 +21,68 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ._clock import ClockJump
+from ._time import ClockType, Time
 
 if TYPE_CHECKING:
+    from ._clock import Clock
     from ._groups import CallbackGroup
     from ._node import Node
 
-__all__ = ["Rate", "Timer", "TimerStatistics"]
+__all__ = ["Rate", "Timer", "TimerInfo", "TimerStatistics"]
+
+
+class TimerInfo:
+    """When a timer call was due and when it ran (rclpy's ``TimerInfo``), on the timer's clock.
+
+    A timer callback that takes one argument (or has a parameter annotated
+    ``TimerInfo``) receives it.
+    """
+
+    __slots__ = ("_actual", "_expected")
+
+    def __init__(
+        self, *, expected_call_time: int = 0, actual_call_time: int = 0, clock_type: ClockType = ClockType.SYSTEM_TIME
+    ) -> None:
+        if not isinstance(clock_type, ClockType):
+            raise TypeError(f"clock_type must be a ClockType, got {clock_type!r}")
+        if expected_call_time < 0 or actual_call_time < 0:
+            raise ValueError(
+                f"call times must not be negative, got expected_call_time={expected_call_time}, "
+                f"actual_call_time={actual_call_time}"
+            )
+        self._expected = Time(nanoseconds=expected_call_time, clock_type=clock_type)
+        self._actual = Time(nanoseconds=actual_call_time, clock_type=clock_type)
+
+    def __repr__(self) -> str:
+        return f"<TimerInfo expected={self._expected.nanoseconds} actual={self._actual.nanoseconds}>"
+
+    @property
+    def expected_call_time(self) -> Time:
+        return self._expected
+
+    @property
+    def actual_call_time(self) -> Time:
+        return self._actual
+
+
+def _info_parameter(callback: Callable[..., Any]) -> str | None:
+    """How ``callback`` wants its :class:`TimerInfo`: a parameter name, ``""`` for positionally, or None.
+
+    As rclpy, a parameter annotated ``TimerInfo`` gets it by name; beyond rclpy, a
+    callback with exactly one required positional parameter gets it positionally.
+    """
+    try:
+        sig = inspect.signature(callback)
+    except (TypeError, ValueError):
+        return None
+    required = 0
+    for p in sig.parameters.values():
+        if p.annotation is TimerInfo or p.annotation == "TimerInfo":
+            return p.name
+        if p.kind in (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD):
+            if p.default is inspect.Parameter.empty:
+                required += 1
+    return "" if required == 1 else None
 
 #: How many recent lateness samples a timer keeps for its percentiles.
 _WINDOW = 4096
@@ -52,7 +110,13 @@ def _percentile(sorted_values: list[int], q: float) -> int:
 
 
 class Timer:
-    """Calls ``callback`` every ``period_sec``; created by ``Node.create_timer``."""
+    """Calls ``callback`` every ``period_sec``; created by ``Node.create_timer``.
+
+    A callback taking one argument gets a :class:`TimerInfo` (when the call was
+    due and when it ran, on the node clock), as rclpy passes one to a parameter
+    annotated ``TimerInfo``. ``with node.create_timer(...) as timer:`` destroys it
+    at the end of the block.
+    """
 
     def __init__(
         self,
@@ -68,6 +132,8 @@ class Timer:
         self.node = node
         self.period_ns = round(period_sec * 1e9)
         self.callback = callback
+        self._info_param = _info_parameter(callback)
+        self._last_call_ns: int | None = None
         self.callback_group = group
         self._task: asyncio.Task[None] | None = None
         self._cancelled = not autostart
@@ -87,6 +153,51 @@ class Timer:
     @property
     def timer_period_ns(self) -> int:
         return self.period_ns
+
+    @property
+    def clock(self) -> Clock:
+        """The clock the timer runs on: the node's."""
+        return self.node._clock
+
+    def time_until_next_call(self) -> int | None:
+        """Nanoseconds until the next call (negative when overdue); ``None`` when cancelled (rclpy)."""
+        if self._cancelled:
+            return None
+        if self._next_ns is None:
+            return self.period_ns
+        return self._next_ns - self._now()
+
+    def time_since_last_call(self) -> int:
+        """Nanoseconds since the last call started (or since the timer started, before any)."""
+        if self._last_call_ns is not None:
+            return self._now() - self._last_call_ns
+        if self._next_ns is None:
+            return 0
+        return self._now() - (self._next_ns - self.period_ns)
+
+    def __enter__(self) -> Timer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.destroy()
+
+    def _callback_for(self, deadline_ns: int) -> Callable[[], Any]:
+        """The callback as the executor calls it: with a :class:`TimerInfo` when it takes one."""
+        if self._info_param is None:
+            return self.callback
+        return functools.partial(self._call_with_info, deadline_ns)
+
+    def _call_with_info(self, deadline_ns: int) -> Any:
+        clock = self.node._clock
+        actual = clock.now_ns()
+        # deadlines are monotonic instants on wall time: express the due time on the node clock
+        expected = deadline_ns if clock.use_sim_time else actual - (time.monotonic_ns() - deadline_ns)
+        info = TimerInfo(
+            expected_call_time=max(expected, 0), actual_call_time=max(actual, 0), clock_type=clock.clock_type
+        )
+        if self._info_param:
+            return self.callback(**{self._info_param: info})
+        return self.callback(info)
 
     @property
     def stats(self) -> TimerStatistics:
@@ -189,11 +300,12 @@ class Timer:
             if now < deadline:
                 continue  # woken early by a poke
             group = self.callback_group
+            callback = self._callback_for(deadline)
             if group.exclusive:
-                await node._invoke(self, group, self.callback, start_deadline=deadline)
+                await node._invoke(self, group, callback, start_deadline=deadline)
             else:
                 node._create_task(
-                    node._invoke(self, group, self.callback, start_deadline=deadline),
+                    node._invoke(self, group, callback, start_deadline=deadline),
                     name="timer callback",
                 )
             # Next deadline on the grid; skip the ones the callback overran.
@@ -207,7 +319,9 @@ class Timer:
                 self._next_ns = nxt
 
     def _record_start(self, deadline_ns: int) -> None:
-        late = self._now() - deadline_ns
+        now = self._now()
+        self._last_call_ns = now
+        late = now - deadline_ns
         if late < 0:
             late = 0
         self._calls += 1
@@ -227,6 +341,7 @@ class Rate:
             raise ValueError(f"rate: expected a frequency in Hz > 0, got {frequency!r}")
         self.node = node
         self.period_ns = round(1e9 / frequency)
+        self.destroyed = False
         # The grid starts at creation, as ROS's Rate; a node not yet running starts it at the first sleep.
         self._next_ns: int | None = self._now() + self.period_ns if node._loop is not None else None
 
@@ -237,7 +352,13 @@ class Rate:
         clock = self.node._clock
         return clock.now_ns() if clock.use_sim_time else time.monotonic_ns()
 
+    def destroy(self) -> None:
+        """Retire the rate (``Node.destroy_rate``): a later ``sleep()`` raises."""
+        self.destroyed = True
+
     async def sleep(self) -> None:
+        if self.destroyed:
+            raise RuntimeError(f"{self!r} was destroyed")
         now = self._now()
         if self._next_ns is None:
             self._next_ns = now + self.period_ns

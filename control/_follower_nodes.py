@@ -91,6 +91,10 @@ class GoToGoalController(_FollowerNode):
     """Drives to each ``/goal_pose`` (geometry_msgs/PoseStamped, odometry frame) with :class:`GoToGoal`.
 
     The goal's orientation is used as a final yaw when ``use_goal_yaw`` is set.
+
+    rclpy difference: the goal must be in the odometry frame; it is not transformed
+    with tf as Nav2's controllers transform their input. A goal in another frame is
+    ignored with a warning naming both frames.
     """
 
     def __init__(self, **kw: Any) -> None:
@@ -124,7 +128,12 @@ class GoToGoalController(_FollowerNode):
 
 
 class PurePursuitController(_FollowerNode):
-    """Follows each ``/plan`` (nav_msgs/Path, odometry frame) with :class:`PurePursuit`."""
+    """Follows each ``/plan`` (nav_msgs/Path, odometry frame) with :class:`PurePursuit`.
+
+    rclpy difference: the plan must be in the odometry frame; it is not transformed
+    with tf as Nav2's controller server transforms the global plan. A plan in another
+    frame is ignored with a warning naming both frames.
+    """
 
     def __init__(self, **kw: Any) -> None:
         super().__init__("pure_pursuit", **kw)

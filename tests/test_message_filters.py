@@ -61,7 +61,7 @@ async def test_approximate_synchronizer_end_to_end_with_jittered_stamps(runtime)
     sync = ApproximateTimeSynchronizer(
         [Subscriber(node, PointStamped, "/a", 50), Subscriber(node, Vector3Stamped, "/b", 50)],
         queue_size=10,
-        slop_sec=0.02,
+        slop=0.02, policy="cpp",
     )
     got = []
 
@@ -85,7 +85,7 @@ async def test_three_inputs_call_back_in_the_order_given(runtime):
     topics = ["/x", "/y", "/z"]
     publishers = [pubs.create_publisher(PointStamped, t, 10) for t in topics]
     subs = [Subscriber(node, PointStamped, t) for t in reversed(topics)]  # z, y, x
-    sync = ApproximateTimeSynchronizer(subs, queue_size=5, slop_sec=0.05)
+    sync = ApproximateTimeSynchronizer(subs, queue_size=5, slop=0.05)
     got = []
     sync.register_callback(lambda *msgs: got.append(tuple(m.point.x for m in msgs)))
     for t in (1.0, 2.0, 3.0):
@@ -180,7 +180,7 @@ async def test_synchronizer_rejects_non_filter_inputs(runtime):
     node = runtime.add_node(Node("listener"))
     with pytest.raises(TypeError, match=r"inputs must be message filters \(e\.g\. message_filters\.Subscriber\), got '/a'"):
         TimeSynchronizer([Subscriber(node, PointStamped, "/b"), "/a"], 10)
-    with pytest.raises(ValueError, match=r"^slop_sec: expected a number of seconds >= 0, got -0\.1$"):
+    with pytest.raises(ValueError, match=r"^slop: expected a number of seconds >= 0, got -0\.1$"):
         ApproximateTimeSynchronizer([Subscriber(node, PointStamped, "/c"), Subscriber(node, PointStamped, "/d")], 5, -0.1)
 
 

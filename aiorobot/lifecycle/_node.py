@@ -125,7 +125,13 @@ class LifecycleNode(Node):
         return TransitionCallbackReturn.SUCCESS
 
     async def on_shutdown(self) -> None:
-        """Runtime shutdown: take the shutdown transition unless finalized (as rclcpp on destruction)."""
+        """Runtime shutdown: take the shutdown transition unless finalized (as rclcpp on destruction).
+
+        rclpy difference: rclpy's ``LifecycleNode.on_shutdown(state)`` is the shutdown
+        *transition* hook; here that hook is ``on_shutdown_transition`` and
+        ``on_shutdown`` is every node's runtime-shutdown hook (aiorobot's ``Node``
+        contract), so a subclass overriding it must await ``super().on_shutdown()``.
+        """
         state = self._machine.state
         if state.is_primary and state is not LifecycleState.FINALIZED:
             try:

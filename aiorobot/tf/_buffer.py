@@ -208,6 +208,11 @@ class Buffer(BufferCore):
             frame that never appeared, ``ExtrapolationException`` for data that does
             not reach ``time``...), its message prefixed with the timeout. At once,
             with ``ExtrapolationException``, for a time older than the cache can hold.
+
+        rclpy difference: tf2_ros has no awaitable with a timeout (``can_transform``
+        with a timeout returns ``False``, ``wait_for_transform_async`` never times
+        out); this one raises the tf exception that still holds, so the caller
+        learns why (which frame is missing, how far the data reaches).
         """
         await self._wait(_Waiter(target_frame, source_frame, time_ns(time)), timeout_sec)
 

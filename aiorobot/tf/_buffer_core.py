@@ -25,6 +25,7 @@ from ._exceptions import (
     LookupException,
     TransformException,
 )
+from ._plans import trace_plan, walk_plan
 from ._views import FrameInfo, frames_as_dot, frames_as_yaml
 from ._math import IDENTITY_QUAT, Quat, Vec, _canonical, _qinv, _qmul, _qrot
 from ._msgs import make_transform_stamped, time_ns, time_from_ns
@@ -63,6 +64,8 @@ class BufferCore:
         self._names: list[str] = [_NO_PARENT]
         self._caches: list[TimeCache | StaticCache | None] = [None]
         self._authority: dict[int, str] = {}
+        # per (target_frame, source_frame): [target_id, source_id, plan or None (not traced yet) or False]
+        self._plans: dict[tuple[str, str], list[Any]] = {}
 
     @property
     def cache_time_sec(self) -> float:
@@ -155,6 +158,9 @@ class BufferCore:
             if cache is None or cache.is_static != static:
                 cache = StaticCache() if static else TimeCache(self._cache_ns)
                 self._caches[child_id] = cache
+                self._plans.clear()  # the tree's shape changed
+            elif cache.latest_time_and_parent()[1] != parent_id:
+                self._plans.clear()  # a new parent (re-parenting)
             sample: Sample = (parent_id, t[0], t[1], t[2], qc[0], qc[1], qc[2], qc[3])
             if not cache.insert(stamp_ns, sample):
                 latest = cache.latest_stamp()
@@ -187,6 +193,7 @@ class BufferCore:
     def clear(self) -> None:
         """Forget every dynamic transform; static transforms stay (as in tf2)."""
         with self._lock:
+            self._plans.clear()
             for cache in self._caches:
                 if cache is not None:
                     cache.clear()
@@ -402,9 +409,22 @@ class BufferCore:
                     t = cache.latest_stamp() if cache is not None else 0
             return t, _ZERO, IDENTITY_QUAT
         with self._lock:
-            target_id = self._validate(target_frame, f"{where} argument target_frame")
-            source_id = self._validate(source_frame, f"{where} argument source_frame")
-            t_out, vec, q = self._walk(target_id, source_id, t, True)
+            entry = self._plans.get((target_frame, source_frame))
+            if entry is None:
+                target_id = self._validate(target_frame, f"{where} argument target_frame")
+                source_id = self._validate(source_frame, f"{where} argument source_frame")
+                entry = self._plans[(target_frame, source_frame)] = [target_id, source_id, None]
+            target_id, source_id, plan = entry
+            if t == 0:
+                t = self._latest_common_time(target_id, source_id)
+            replayed = walk_plan(plan, t) if plan else None
+            if replayed is not None:
+                t_out = t
+                vec, q = replayed
+            else:
+                t_out, vec, q = self._walk(target_id, source_id, t, True)
+                if plan is None:
+                    entry[2] = trace_plan(self._caches, target_id, source_id, t_out, MAX_GRAPH_DEPTH) or False
         # tf2 hands the result through a rotation matrix: same sign convention
         return t_out, vec, _canonical(q)
 

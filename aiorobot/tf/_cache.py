@@ -9,6 +9,7 @@ chooses the exception type, as tf2 does.
 
 from __future__ import annotations
 
+import math
 from bisect import bisect_left, bisect_right
 
 from ._math import _slerp
@@ -52,13 +53,42 @@ class TimeCache:
     older sample is returned unchanged (re-parenting never interpolates).
     """
 
-    __slots__ = ("_max_ns", "stamps", "samples")
+    __slots__ = ("_intervals", "_max_ns", "samples", "stamps")
     is_static = False
 
     def __init__(self, max_storage_ns: int) -> None:
         self._max_ns = max_storage_ns
         self.stamps: list[int] = []
         self.samples: list[Sample] = []
+        # slerp constants per interval index; indices shift on every change, so any change clears it
+        self._intervals: dict[int, tuple[float, ...]] = {}
+
+    def interval(self, i: int) -> tuple[float, ...]:
+        """Slerp constants between samples ``i`` and ``i + 1``: ``(theta, a / sin(theta), b' / sin(theta))``.
+
+        ``b'`` is ``b`` with its sign flipped when that is the shorter way (as
+        ``_slerp``); with ``theta = 0`` the rotation is ``a`` itself. Then
+        ``slerp(a, b, r) = a' sin((1 - r) theta) + b' sin(r theta)``.
+        """
+        found = self._intervals.get(i)
+        if found is not None:
+            return found
+        a = self.samples[i]
+        b = self.samples[i + 1]
+        ax, ay, az, aw = a[4], a[5], a[6], a[7]
+        bx, by, bz, bw = b[4], b[5], b[6], b[7]
+        dot = ax * bx + ay * by + az * bz + aw * bw
+        s = math.sqrt((ax * ax + ay * ay + az * az + aw * aw) * (bx * bx + by * by + bz * bz + bw * bw))
+        c = (-dot if dot < 0 else dot) / s
+        theta = math.acos(c if c < 1.0 else 1.0)
+        if theta == 0.0:
+            found = (0.0, ax, ay, az, aw, 0.0, 0.0, 0.0, 0.0)
+        else:
+            d = 1.0 / math.sin(theta)
+            e = -d if dot < 0 else d
+            found = (theta, ax * d, ay * d, az * d, aw * d, bx * e, by * e, bz * e, bw * e)
+        self._intervals[i] = found
+        return found
 
     # -- queries -------------------------------------------------------------------
 
@@ -130,10 +160,19 @@ class TimeCache:
     # -- updates -------------------------------------------------------------------
 
     def insert(self, stamp: int, sample: Sample) -> bool:
-        """Insert a sample; False (and no change) when it is older than the cache length."""
+        """Insert a sample; False (and no change) when it is older than the cache length.
+
+        As tf2's ``TimeCache::insertData`` (Jazzy): the cache is pruned *before*
+        the insert, against the newest stamp held so far, so a sample older than
+        the cache length survives until the next insert and interpolation just
+        inside the boundary still works. An exact duplicate is not stored twice.
+        """
         stamps = self.stamps
-        if stamps and stamp < stamps[-1] - self._max_ns:
-            return False
+        if stamps:
+            latest = stamps[-1]
+            self._prune(latest)
+            if stamp < latest - self._max_ns:
+                return False
         i = bisect_right(stamps, stamp)
         j = i
         while j > 0 and stamps[j - 1] == stamp:
@@ -142,19 +181,22 @@ class TimeCache:
                 return True  # exact duplicate: nothing to do
         stamps.insert(i, stamp)
         self.samples.insert(i, sample)
-        self._prune()
+        self._intervals.clear()
         return True
 
-    def _prune(self) -> None:
+    def _prune(self, latest: int) -> None:
+        """Drop samples older than ``latest`` minus the cache length (tf2's ``pruneList``)."""
         stamps = self.stamps
-        k = bisect_left(stamps, stamps[-1] - self._max_ns)
+        k = bisect_left(stamps, latest - self._max_ns)
         if k:
             del stamps[:k]
             del self.samples[:k]
+            self._intervals.clear()
 
     def clear(self) -> None:
         self.stamps.clear()
         self.samples.clear()
+        self._intervals.clear()
 
 
 class StaticCache:

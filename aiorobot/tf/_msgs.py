@@ -53,19 +53,46 @@ def stamp_msg(ns: int) -> Any:
     return TimeMsg(sec=sec, nanosec=nanosec)
 
 
-def make_transform_stamped(frame_id: str, child_frame_id: str, stamp_ns: int, t: Vec, q: Quat) -> Any:
-    """A ``geometry_msgs/msg/TransformStamped`` holding ``child2frame``."""
-    from aiorobot.msgs.geometry_msgs import Quaternion, Transform, TransformStamped, Vector3
-    from aiorobot.msgs.std_msgs import Header
+_classes: tuple[type, ...] | None = None
 
-    return TransformStamped(
-        header=Header(stamp=stamp_msg(stamp_ns), frame_id=frame_id),
-        child_frame_id=child_frame_id,
-        transform=Transform(
-            translation=Vector3(x=t[0], y=t[1], z=t[2]),
-            rotation=Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]),
-        ),
-    )
+
+def _transform_classes() -> tuple[type, ...]:
+    global _classes
+    if _classes is None:
+        from aiorobot.msgs.builtin_interfaces import Time as TimeMsg
+        from aiorobot.msgs.geometry_msgs import Quaternion, Transform, TransformStamped, Vector3
+        from aiorobot.msgs.std_msgs import Header
+
+        _classes = (TransformStamped, Header, TimeMsg, Transform, Vector3, Quaternion)
+    return _classes
+
+
+def make_transform_stamped(frame_id: str, child_frame_id: str, stamp_ns: int, t: Vec, q: Quat) -> Any:
+    """A ``geometry_msgs/msg/TransformStamped`` holding ``child2frame``.
+
+    Built field by field without the constructors' argument handling: every value
+    here is already of its field's type (str, int in range, float), and a lookup
+    makes one of these per call, so the constructors' cost would dominate it.
+    """
+    ts_cls, header_cls, time_cls, transform_cls, vector_cls, quat_cls = _classes or _transform_classes()
+    new = object.__new__
+    stamp = new(time_cls)
+    stamp.sec, stamp.nanosec = divmod(stamp_ns, _NS)
+    header = new(header_cls)
+    header.stamp = stamp
+    header.frame_id = frame_id
+    translation = new(vector_cls)
+    translation.x, translation.y, translation.z = t
+    rotation = new(quat_cls)
+    rotation.x, rotation.y, rotation.z, rotation.w = q
+    transform = new(transform_cls)
+    transform.translation = translation
+    transform.rotation = rotation
+    msg = new(ts_cls)
+    msg.header = header
+    msg.child_frame_id = child_frame_id
+    msg.transform = transform
+    return msg
 
 
 def transform_stamped_parts(msg: Any) -> tuple[str, str, int, Vec, Quat]:

@@ -262,7 +262,9 @@ def test_clear_forgets_dynamic_data_and_keeps_statics(robot):
 # ----------------------------------------------------------------------------- cache length
 
 
-def test_samples_older_than_newest_minus_cache_length_are_pruned_at_the_boundary():
+def test_samples_older_than_newest_minus_cache_length_are_pruned_at_the_next_insert():
+    # geometry2 tf2/src/cache.cpp TimeCache::insertData (Jazzy): prune before inserting, against the
+    # newest stamp held before the new sample.
     b = Buffer(cache_time_sec=10.0)
     b.set_transform(tf("odom", "base_link", 100, (0, 0, 0)), "a")
     b.set_transform(tf("odom", "base_link", 105, (5, 0, 0)), "a")
@@ -270,9 +272,13 @@ def test_samples_older_than_newest_minus_cache_length_are_pruned_at_the_boundary
     # exactly newest - cache length: kept
     assert xyz_of(b.lookup_transform("odom", "base_link", T(seconds=100))) == approx((0, 0, 0))
     b.set_transform(tf("odom", "base_link", 110.5, (10.5, 0, 0)), "a")
+    # 100 is now older than 110.5 - 10 but survives until the next insert: the boundary still interpolates
+    assert xyz_of(b.lookup_transform("odom", "base_link", T(seconds=100.25))) == approx((0.25, 0, 0))
+    b.set_transform(tf("odom", "base_link", 111, (11, 0, 0)), "a")
     with pytest.raises(ExtrapolationException, match="earliest data is at time 105.000000"):
         b.lookup_transform("odom", "base_link", T(seconds=100))
     assert xyz_of(b.lookup_transform("odom", "base_link", T(seconds=105))) == approx((5, 0, 0))
+
 
 def test_an_insert_older_than_the_cache_length_is_refused_with_a_warning(caplog):
     b = Buffer(cache_time_sec=10.0)
