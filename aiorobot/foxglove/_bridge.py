@@ -220,7 +220,7 @@ class FoxgloveBridge(Node):
         out = []
         for node in self._nodes():
             prefix = node.get_fully_qualified_name()
-            for pname in node.list_parameters():
+            for pname in node.list_parameters().names:
                 full = f"{prefix}.{pname}"
                 if names and full not in names:
                     continue
