@@ -15,7 +15,8 @@ TEST_NAMESPACE = "/my_ns"
 
 @pytest.fixture
 def node(runtime):
-    return runtime.add_node(Node(TEST_NODE, namespace=TEST_NAMESPACE))
+    # Without its parameter services, so the graph holds only what each test creates.
+    return runtime.add_node(Node(TEST_NODE, namespace=TEST_NAMESPACE, start_parameter_services=False))
 
 
 def test_count_clients_services(node):
@@ -76,7 +77,7 @@ def test_node_names_and_namespaces(runtime, node):
 
 def test_service_and_client_names_and_types_by_node(runtime, node):
     # rclpy test_node.py::TestNode::test_service_names_and_types(_by_node), ::test_client_names_and_types_by_node
-    other = runtime.add_node(Node("other"))
+    other = runtime.add_node(Node("other", start_parameter_services=False))
     node.create_service(AddTwoInts, "add", lambda req: AddTwoInts.Response())
     other.create_client(AddTwoInts, "/my_ns/add")
     other.create_client(GetParameters, "/params")
@@ -104,7 +105,8 @@ def test_publisher_and_subscriber_names_and_types_by_node(node):
     node.create_publisher(String, "out", 1)
     node.create_subscription(String, "in", lambda m: None, 1)
     assert node.get_publisher_names_and_types_by_node(TEST_NODE, TEST_NAMESPACE) == [
-        ("/my_ns/out", ["std_msgs/msg/String"])
+        ("/my_ns/out", ["std_msgs/msg/String"]),
+        ("/parameter_events", ["rcl_interfaces/msg/ParameterEvent"]),  # every node has it, as in rclpy
     ]
     assert node.get_subscriber_names_and_types_by_node(TEST_NODE, TEST_NAMESPACE) == [
         ("/my_ns/in", ["std_msgs/msg/String"])
