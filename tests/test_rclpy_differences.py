@@ -78,6 +78,8 @@ def marked_objects() -> dict[int, tuple[str, Any]]:
                         continue
                     member = inspect.getattr_static(obj, member_name)
                     value = getattr(obj, member_name, member)
+                    if type(value) is obj and getattr(value, "__doc__", None) == obj.__doc__:
+                        continue  # an enum member or instance carrying its class's docstring: the class is listed
                     if has_marker(member) or has_marker(value):
                         found.setdefault(id(identity(value)), (f"{qualified}.{member_name}", value))
     return found
