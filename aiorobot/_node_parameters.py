@@ -26,6 +26,7 @@ class NodeParametersMixin:
         description: str = "",
         read_only: bool = False,
         range: Iterable[float] | None = None,
+        default: Any = None,
     ) -> Parameter:
         """Declare a parameter; an override given to the node replaces ``value``.
 
@@ -33,7 +34,7 @@ class NodeParametersMixin:
         one (reading it before it has a value raises ``ParameterUninitializedError``);
         ``declare_parameter(name)`` alone declares a dynamically typed parameter.
         ``descriptor`` is a :class:`ParameterDescriptor` (or the ``rcl_interfaces``
-        message); the keywords ``description``, ``read_only`` and ``range``
+        message); ``default=`` is another name for ``value``; the keywords ``description``, ``read_only`` and ``range``
         (``(from, to)`` or ``(from, to, step)``) are aiorobot's shorthand for it.
         The value goes through the same checks and on-set callbacks as a set:
         ``InvalidParameterTypeError`` for a wrong type, ``InvalidParameterValueError``
@@ -43,6 +44,10 @@ class NodeParametersMixin:
         double arrays), as TOML and YAML users write ``2`` for ``2.0``; declaring with only a
         name does not warn.
         """
+        if default is not None:  # API.md's name for the value
+            if value is not None:
+                raise TypeError(f"declare_parameter({name!r}): give value or default, not both")
+            value = default
         return self._parameters.declare(
             name,
             value,
