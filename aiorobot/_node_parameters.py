@@ -16,6 +16,20 @@ class NodeParametersMixin:
 
     _parameters: ParameterStore
 
+    def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
+        """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
+        from .parameters._services import ParameterEventPublisher, create_parameter_services
+        from ._time_source import TimeSource
+
+        self._parameters.event_hook = ParameterEventPublisher(self)  # type: ignore[arg-type]
+        if auto_declare:
+            overrides = self._parameters.overrides
+            self.declare_parameters("", [(n, v) for n, v in overrides.items()], ignore_override=True)
+            self._parameters._claimed.update(overrides)
+        self._time_source = TimeSource(self)  # type: ignore[arg-type]
+        if start_services:
+            create_parameter_services(self)  # type: ignore[arg-type]
+
     def declare_parameter(
         self,
         name: str,
