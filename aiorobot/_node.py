@@ -83,7 +83,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         from ._node_arguments import resolve_node_arguments
 
         arguments = resolve_node_arguments(
-            name, namespace, _overrides_dict(parameter_overrides), dict(remappings or {}), cli_args
+            name, namespace, parameter_overrides, dict(remappings or {}), cli_args
         )
         remaps = arguments.remappings
         for key, value in remaps.items():
@@ -115,20 +115,6 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._clock: Clock = Clock()
         self._started = False
         self._setup_parameters(automatically_declare_parameters_from_overrides, start_parameter_services)
-
-    def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
-        """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
-        from .parameters._services import ParameterEventPublisher, create_parameter_services
-        from ._time_source import TimeSource
-
-        self._parameters.event_hook = ParameterEventPublisher(self)
-        if auto_declare:
-            overrides = self._parameters.overrides
-            self.declare_parameters("", [(n, v) for n, v in overrides.items()], ignore_override=True)
-            self._parameters._claimed.update(overrides)
-        self._time_source = TimeSource(self)
-        if start_services:
-            create_parameter_services(self)
 
     def __repr__(self) -> str:
         where = f" on {self._executor}" if self._executor else " (not added)"
@@ -603,22 +589,6 @@ def _describe(entity: Any) -> str:
     if isinstance(entity, Timer):
         return f"timer {entity.period_ns / 1e9:g}s"
     return repr(entity)
-
-
-def _overrides_dict(overrides: Mapping[str, Any] | Iterable[Any] | None) -> dict[str, Any]:
-    """Overrides as ``{name: value}``: a mapping, or rclpy's list of ``Parameter``."""
-    if overrides is None:
-        return {}
-    if isinstance(overrides, Mapping):
-        return dict(overrides)
-    from ._parameters import Parameter
-
-    out = {}
-    for p in overrides:
-        if not isinstance(p, Parameter):
-            raise TypeError(f"parameter_overrides: expected a mapping or a list of Parameter, found {p!r}")
-        out[p.name] = p.value
-    return out
 
 
 def _check_msg_type(msg_type: Any) -> None:

@@ -3,7 +3,7 @@ values and ``--params-file`` sections matched to the node's fully qualified name
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -26,12 +26,13 @@ class NodeArguments:
 def resolve_node_arguments(
     name: str,
     namespace: str,
-    overrides: dict[str, Any],
+    parameter_overrides: Mapping[str, Any] | Iterable[Any] | None,
     remappings: dict[str, str],
     cli_args: Sequence[str] | None,
 ) -> NodeArguments:
-    """Precedence, lowest first: parameter files in order, ``-p`` values, ``parameter_overrides``;
-    ``-r`` rules, then ``remappings``."""
+    """Precedence, lowest first: parameter files in order, ``-p`` values, ``parameter_overrides``
+    (a mapping or rclpy's list of ``Parameter``); ``-r`` rules, then ``remappings``."""
+    overrides = _overrides_dict(parameter_overrides)
     if cli_args is None:
         return NodeArguments(overrides, remappings)
     if isinstance(cli_args, str) or not all(isinstance(a, str) for a in cli_args):
@@ -53,3 +54,19 @@ def resolve_node_arguments(
     merged.update(overrides)
     level = args.log_levels.get(final_name, args.log_levels.get(fqn, args.log_level))  # --log-level name:=level
     return NodeArguments(merged, remaps, quiet, level)
+
+
+def _overrides_dict(overrides: Mapping[str, Any] | Iterable[Any] | None) -> dict[str, Any]:
+    """Overrides as ``{name: value}``: a mapping, or rclpy's list of ``Parameter``."""
+    if overrides is None:
+        return {}
+    if isinstance(overrides, Mapping):
+        return dict(overrides)
+    from ._parameters import Parameter
+
+    out = {}
+    for p in overrides:
+        if not isinstance(p, Parameter):
+            raise TypeError(f"parameter_overrides: expected a mapping or a list of Parameter, found {p!r}")
+        out[p.name] = p.value
+    return out

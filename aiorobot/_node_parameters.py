@@ -16,6 +16,20 @@ class NodeParametersMixin:
 
     _parameters: ParameterStore
 
+    def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
+        """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
+        from .parameters._services import ParameterEventPublisher, create_parameter_services
+        from ._time_source import TimeSource
+
+        self._parameters.event_hook = ParameterEventPublisher(self)  # type: ignore[arg-type]
+        if auto_declare:
+            overrides = self._parameters.overrides
+            self.declare_parameters("", [(n, v) for n, v in overrides.items()], ignore_override=True)
+            self._parameters._claimed.update(overrides)
+        self._time_source = TimeSource(self)  # type: ignore[arg-type]
+        if start_services:
+            create_parameter_services(self)  # type: ignore[arg-type]
+
     def declare_parameter(
         self,
         name: str,
@@ -26,6 +40,7 @@ class NodeParametersMixin:
         description: str = "",
         read_only: bool = False,
         range: Iterable[float] | None = None,
+        default: Any = None,
     ) -> Parameter:
         """Declare a parameter; an override given to the node replaces ``value``.
 
@@ -33,7 +48,7 @@ class NodeParametersMixin:
         one (reading it before it has a value raises ``ParameterUninitializedError``);
         ``declare_parameter(name)`` alone declares a dynamically typed parameter.
         ``descriptor`` is a :class:`ParameterDescriptor` (or the ``rcl_interfaces``
-        message); the keywords ``description``, ``read_only`` and ``range``
+        message); ``default=`` is another name for ``value``; the keywords ``description``, ``read_only`` and ``range``
         (``(from, to)`` or ``(from, to, step)``) are aiorobot's shorthand for it.
         The value goes through the same checks and on-set callbacks as a set:
         ``InvalidParameterTypeError`` for a wrong type, ``InvalidParameterValueError``
@@ -43,6 +58,10 @@ class NodeParametersMixin:
         double arrays), as TOML and YAML users write ``2`` for ``2.0``; declaring with only a
         name does not warn.
         """
+        if default is not None:  # API.md's name for the value
+            if value is not None:
+                raise TypeError(f"declare_parameter({name!r}): give value or default, not both")
+            value = default
         return self._parameters.declare(
             name,
             value,

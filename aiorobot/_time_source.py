@@ -6,11 +6,10 @@ parameter file, ``-p use_sim_time:=true`` or a set at run time - gets a clock of
 own, fed from ``/clock`` by a subscription of its own when it is on, and its timers
 restart their period on the new time base.
 
-A node that follows the runtime shares the runtime's clock; its first switch moves it to
-a clock of its own, so jump callbacks registered on ``node.get_clock()`` before that
-switch stay on the runtime's clock (register them after setting ``use_sim_time``, or
-give the node a ``use_sim_time`` override, which gives it its own clock from the start
-when it differs from the runtime's).
+In a wall-time runtime every node has its own ROS clock, so jump callbacks registered on
+``node.get_clock()`` see ROS time switch on and off. In a sim-time runtime nodes share the
+runtime's clock; switching one off moves it to a clock of its own, and jump callbacks
+registered on ``node.get_clock()`` before that stay on the runtime's clock.
 """
 
 from __future__ import annotations
@@ -53,12 +52,16 @@ class TimeSource:
         return bool(self.node._parameters._values[PARAMETER].value)
 
     def clock_for(self, runtime: Runtime) -> Clock:
-        """The clock ``node`` uses in ``runtime`` (called when it is added)."""
+        """The clock ``node`` uses in ``runtime`` (called when it is added).
+
+        In a wall-time runtime every node has a ROS clock of its own (ROS time off until its
+        parameter turns it on), so jump callbacks on ``node.get_clock()`` see the switch; in
+        a sim-time runtime a node shares the runtime's clock until its parameter says otherwise.
+        """
         if not self.explicit:  # follow the runtime, and say so in the parameter
             store = self.node._parameters
             store._values[PARAMETER] = Parameter(PARAMETER, value=bool(runtime.use_sim_time))
-            return runtime.clock
-        if self.wanted == runtime.use_sim_time and self._own is None:
+        if runtime.use_sim_time and self.wanted and self._own is None:
             return runtime.clock
         return self._own_clock(runtime)
 
@@ -89,7 +92,7 @@ class TimeSource:
         runtime = node._runtime
         if runtime is None:
             return  # decided when the node is added
-        clock = self._own_clock(runtime) if (self.wanted != runtime.use_sim_time or self._own) else runtime.clock
+        clock = runtime.clock if (runtime.use_sim_time and self.wanted and self._own is None) else self._own_clock(runtime)
         if clock is not node._clock:
             node._clock = clock
             node._logger._bind_clock(clock)

@@ -140,3 +140,10 @@ def test_array_parameters_keep_their_element_type():
     assert node.declare_parameter("gains", [0.1, 0.2, 0.3]).value == [1.0, 2.0, 3.0]
     [result] = node.set_parameters([Parameter("gains", ["a"])])
     assert not result.successful
+
+
+def test_default_keyword_of_api_md_still_works():
+    node = Node("n")
+    assert node.declare_parameter("speed", default=0.5).value == 0.5
+    with pytest.raises(TypeError, match="value or default, not both"):
+        node.declare_parameter("x", 1, default=2)

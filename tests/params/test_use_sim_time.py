@@ -69,3 +69,19 @@ async def test_timers_follow_the_switched_clock():
             await settle(rt)
         # the period restarted at the switch, on the node's new clock (0 until its first /clock)
         assert ticks == [100_000_000_000, 200_000_000_000]
+
+
+async def test_jump_callbacks_on_the_node_clock_see_ros_time_switch():
+    # rclpy test_time_source.py::test_clock_change: ROS time activated / deactivated through the parameter
+    from aiorobot import ClockChange, JumpThreshold
+
+    async with Runtime(handle_signals=False) as rt:
+        node = rt.add_node(Node("n"))
+        changes: list = []
+        threshold = JumpThreshold(min_forward=None, min_backward=None, on_clock_change=True)
+        handle = node.get_clock().create_jump_callback(threshold, post_callback=lambda j: changes.append(j.clock_change))
+        node.set_parameters([Parameter("use_sim_time", value=True)])
+        node.set_parameters([Parameter("use_sim_time", value=False)])
+        assert changes == [ClockChange.ROS_TIME_ACTIVATED, ClockChange.ROS_TIME_DEACTIVATED]
+        assert node.get_clock() is not rt.clock
+        handle.unregister()
