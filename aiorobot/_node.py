@@ -323,9 +323,11 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             result_timeout=result_timeout,
         )
 
-    def create_action_client(self, action_type: Any, name: str) -> ActionClient:
+    def create_action_client(
+        self, action_type: Any, name: str, *, callback_group: CallbackGroup | None = None
+    ) -> ActionClient:
         """A client of action ``name``: ``handle = await client.send_goal(goal)``."""
-        return ActionClient(self, action_type, name)
+        return ActionClient(self, action_type, name, callback_group=callback_group)
 
     def destroy_service(self, service: Service) -> None:
         if service in self._services:
