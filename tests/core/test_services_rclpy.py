@@ -190,3 +190,22 @@ def test_service_context_manager():
     with node.create_client(Trigger, "empty_service") as cli:
         assert cli.service_name == "/empty_service"
     assert cli.destroyed
+
+
+@pytest.mark.parametrize("factory", ["client", "service"])
+def test_create_client_and_service_validate_the_name(factory):
+    # rclpy rclpy/test/test_node.py::TestNode::test_create_client, ::test_create_service
+    node = Node("n")
+
+    def make(name):
+        if factory == "client":
+            return node.create_client(GetParameters, name)
+        return node.create_service(GetParameters, name, lambda req: None)
+
+    make("get/parameters")
+    with pytest.raises(ValueError, match=r"character '\?' is not allowed"):
+        make("get/parameters?")
+    with pytest.raises(ValueError, match="must not start with a digit"):
+        make("/get/42parameters")
+    with pytest.raises(ValueError, match="unknown substitution"):
+        make("foo/{bad_sub}")
