@@ -240,6 +240,9 @@ class ActionServer:
         self._group = callback_group
         self._goals: dict[bytes, ServerGoalHandle] = {}
         self._finished: deque[bytes] = deque()
+        self._expiring: deque[tuple[int, bytes, ServerGoalHandle]] = deque()
+        self._expiry_wake: asyncio.Future[None] | None = None
+        self._expiry_task: asyncio.Task[None] | None = None
         internal = ReentrantCallbackGroup()
         base = self.name + "/_action/"
         self._services = [
@@ -276,6 +279,8 @@ class ActionServer:
             accepted = verdict is True or verdict == GoalResponse.ACCEPT
         if not accepted:
             return action.SendGoal.Response(accepted=False, stamp=stamp)
+        if self._expiry_task is None or self._expiry_task.done():
+            self._expiry_task = self.node._create_task(self._expire(), name=f"action {self.name} result expiry")
         handle = ServerGoalHandle(self, request.goal_id, request.goal, stamp)
         self._goals[gid] = handle
         self._publish_status()
@@ -339,14 +344,33 @@ class ActionServer:
         self._finished.append(gid)
         while len(self._finished) > MAX_KEPT_RESULTS:
             self._goals.pop(self._finished.popleft(), None)
-        self.node._create_task(self._expire(gid, handle), name=f"goal {_gid_str(handle.goal_id)} expiry")
+        self._expiring.append((self.node.now().nanoseconds + round(self.result_timeout * 1e9), gid, handle))
+        wake = self._expiry_wake
+        if wake is not None and not wake.done():
+            wake.set_result(None)
 
-    async def _expire(self, gid: bytes, handle: ServerGoalHandle) -> None:
-        """Forget a finished goal ``result_timeout`` seconds (node clock) after it finished."""
-        never: asyncio.Future[None] = asyncio.get_running_loop().create_future()
-        try:
-            await self.node._wait_with_timeout(never, self.result_timeout)
-        except TimeoutError:
+    async def _expire(self) -> None:
+        """Forget each finished goal ``result_timeout`` seconds (node clock) after it finished.
+
+        One task per server, started with the first goal, so the node's shutdown cancels it
+        with its other tasks.
+        """
+        loop = asyncio.get_running_loop()
+        while True:
+            if not self._expiring:
+                self._expiry_wake = loop.create_future()
+                await self._expiry_wake
+                continue
+            deadline_ns, gid, handle = self._expiring[0]
+            remaining_ns = deadline_ns - self.node.now().nanoseconds
+            if remaining_ns > 0:
+                never: asyncio.Future[None] = loop.create_future()
+                try:
+                    await self.node._wait_with_timeout(never, remaining_ns / 1e9)
+                except TimeoutError:
+                    pass
+                continue
+            self._expiring.popleft()
             if self._goals.get(gid) is handle:
                 del self._goals[gid]
                 self._publish_status()
@@ -513,10 +537,15 @@ class ClientGoalHandle:
 
 
 class ActionClient:
-    """Sends goals to an action server; created by ``Node.create_action_client``."""
+    """Sends goals to an action server; created by ``Node.create_action_client``.
 
-    def __init__(self, node: Node, action_type: Any, name: str) -> None:
+    ``callback_group`` is kept as in rclpy; feedback, status and results are
+    handled in the client's own groups (see :meth:`send_goal`).
+    """
+
+    def __init__(self, node: Node, action_type: Any, name: str, *, callback_group: CallbackGroup | None = None) -> None:
         _check_action_type(action_type)
+        self.callback_group = callback_group
         from .msgs.action_msgs import CancelGoal, GoalStatusArray
 
         self.node = node
@@ -576,22 +605,28 @@ class ActionClient:
         return None
 
     def send_goal_async(
-        self, goal: Any, feedback_callback: Callable[[Any], Any] | None = None
+        self, goal: Any, feedback_callback: Callable[[Any], Any] | None = None, goal_uuid: Any = None
     ) -> Future[ClientGoalHandle]:
         """rclpy's form: a :class:`~aiorobot.Future` of the :class:`ClientGoalHandle` (``.accepted``).
 
         Then ``goal_handle.get_result_async()`` and ``goal_handle.cancel_goal_async()``.
+        ``goal_uuid`` (a ``unique_identifier_msgs/UUID``) fixes the goal id; by default a random one.
+
+        rclpy difference: with no action server the future completes at once with
+        ``ServiceUnavailableError`` (rclpy's stays pending forever); await
+        ``wait_for_server()`` first, as rclpy's examples do.
         """
         action = self.action_type
         if not isinstance(goal, action.Goal):
             raise TypeError(f"send_goal expects {action.Goal.__msgtype__}, got {type(goal).__name__}")
-        return future_of(self.send_goal(goal, feedback_callback), self._loop_for_futures())
+        return future_of(self.send_goal(goal, feedback_callback, goal_uuid=goal_uuid), self._loop_for_futures())
 
     async def send_goal(
         self,
         goal: Any,
         feedback_callback: Callable[[Any], Any] | None = None,
         *,
+        goal_uuid: Any = None,
         timeout_sec: float | None = None,
     ) -> ClientGoalHandle:
         """Send ``goal``; the handle says whether it was ``accepted``.
@@ -611,7 +646,7 @@ class ActionClient:
             raise TypeError(f"send_goal expects {action.Goal.__msgtype__}, got {type(goal).__name__}")
         if not self._send_goal.service_is_ready():
             raise ServiceUnavailableError(f"no action server for {self.name}; await wait_for_server() first")
-        goal_id = UUID(uuid=uuid.uuid4().bytes)
+        goal_id = goal_uuid if goal_uuid is not None else UUID(uuid=uuid.uuid4().bytes)
         handle = ClientGoalHandle(self, goal_id, feedback_callback)
         gid = _gid(goal_id)
         self._handles[gid] = handle  # before sending: feedback may arrive before the reply

@@ -284,19 +284,20 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     def create_service(
         self,
         srv_type: Any,
-        name: str,
-        handler: Callable[..., Any],
+        srv_name: str,
+        callback: Callable[..., Any],
         *,
         callback_group: CallbackGroup | None = None,
     ) -> Service:
-        """Serve ``name`` with ``handler(request) -> response`` (async or sync).
+        """Serve ``srv_name`` with ``callback(request) -> response`` (async or sync).
 
-        rclpy's ``handler(request, response) -> response`` form works too (a handler
-        taking two positional arguments gets a fresh ``Response``). A handler that
+        rclpy's ``callback(request, response) -> response`` form works too (a callback
+        taking two positional arguments gets a fresh ``Response``). A callback that
         raises answers the caller with :class:`ServiceError` carrying the reason.
+        The parameter names are rclpy's.
         """
         service = Service(
-            self, srv_type, self.resolve_topic_name(name, kind="service"), handler, callback_group or self._default_group
+            self, srv_type, self.resolve_topic_name(srv_name, kind="service"), callback, callback_group or self._default_group
         )
         self._services.append(service)
         if self._runtime is not None:
@@ -306,16 +307,16 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         return service
 
     def create_client(
-        self, srv_type: Any, name: str, *, callback_group: CallbackGroup | None = None
+        self, srv_type: Any, srv_name: str, *, callback_group: CallbackGroup | None = None
     ) -> Client:
-        """A client of ``name``: ``await client.wait_for_service()``, ``await client.call(request)``.
+        """A client of ``srv_name``: ``await client.wait_for_service()``, ``await client.call(request)``.
 
         ``client.call_async(request)`` returns an rclpy-style future. ``callback_group``
         is kept on the client as in rclpy; responses complete on the caller's loop,
         which needs no group to serialise them.
         """
         client = Client(
-            self, srv_type, self.resolve_topic_name(name, kind="service"), callback_group or self._default_group
+            self, srv_type, self.resolve_topic_name(srv_name, kind="service"), callback_group or self._default_group
         )
         self._clients.append(client)
         if self._runtime is not None:
@@ -352,9 +353,11 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             result_timeout=result_timeout,
         )
 
-    def create_action_client(self, action_type: Any, name: str) -> ActionClient:
+    def create_action_client(
+        self, action_type: Any, name: str, *, callback_group: CallbackGroup | None = None
+    ) -> ActionClient:
         """A client of action ``name``: ``handle = await client.send_goal(goal)``."""
-        return ActionClient(self, action_type, name)
+        return ActionClient(self, action_type, name, callback_group=callback_group)
 
     def destroy_service(self, service: Service) -> None:
         if service in self._services:

@@ -85,6 +85,17 @@ class _ServiceEndpoint:
     def node_name(self) -> str:
         return self.node.get_fully_qualified_name()
 
+    @property
+    def service_name(self) -> str:
+        """The resolved service name (rclpy's ``service_name``)."""
+        return self.srv_name
+
+    def __enter__(self) -> Any:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.destroy()  # type: ignore[attr-defined]
+
 
 class Service(_ServiceEndpoint):
     """Answers requests with ``handler(request) -> response``; created by ``Node.create_service``.

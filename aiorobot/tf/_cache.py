@@ -64,11 +64,13 @@ class TimeCache:
         self._intervals: dict[int, tuple[float, ...]] = {}
 
     def interval(self, i: int) -> tuple[float, ...]:
-        """Slerp constants between samples ``i`` and ``i + 1``: ``(theta, a / sin(theta), b' / sin(theta))``.
+        """Interpolation constants between samples ``i`` and ``i + 1`` (same parent), computed once.
 
-        ``b'`` is ``b`` with its sign flipped when that is the shorter way (as
-        ``_slerp``); with ``theta = 0`` the rotation is ``a`` itself. Then
-        ``slerp(a, b, r) = a' sin((1 - r) theta) + b' sin(r theta)``.
+        ``(theta, a' (4), b' (4), t0, 1 / (t1 - t0), p0 (3), p1 - p0 (3))`` where
+        ``a' = a / sin(theta)`` and ``b'`` is ``b / sin(theta)`` with its sign flipped
+        when that is the shorter way (as ``_slerp``); then
+        ``slerp(a, b, r) = a' sin((1 - r) theta) + b' sin(r theta)`` and the
+        translation is ``p0 + r (p1 - p0)``. With ``theta = 0`` the rotation is ``a``.
         """
         found = self._intervals.get(i)
         if found is not None:
@@ -82,11 +84,17 @@ class TimeCache:
         c = (-dot if dot < 0 else dot) / s
         theta = math.acos(c if c < 1.0 else 1.0)
         if theta == 0.0:
-            found = (0.0, ax, ay, az, aw, 0.0, 0.0, 0.0, 0.0)
+            rot: tuple[float, ...] = (0.0, ax, ay, az, aw, 0.0, 0.0, 0.0, 0.0)
         else:
             d = 1.0 / math.sin(theta)
             e = -d if dot < 0 else d
-            found = (theta, ax * d, ay * d, az * d, aw * d, bx * e, by * e, bz * e, bw * e)
+            rot = (theta, ax * d, ay * d, az * d, aw * d, bx * e, by * e, bz * e, bw * e)
+        t0 = self.stamps[i]
+        found = (
+            *rot,
+            t0, 1.0 / (self.stamps[i + 1] - t0),
+            a[1], a[2], a[3], b[1] - a[1], b[2] - a[2], b[3] - a[3],
+        )  # fmt: skip
         self._intervals[i] = found
         return found
 

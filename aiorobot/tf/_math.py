@@ -264,7 +264,24 @@ def _m_to_q(m: Mat) -> Quat:
 
 
 def _canonical(q: Quat) -> Quat:
-    return _m_to_q(_q_to_m(q))
+    """``_m_to_q(_q_to_m(q))``: normalised, with tf2's sign. The common branch (trace > 0) is
+    written out with the very same operations, so the result is identical, just cheaper."""
+    x, y, z, w = q
+    s = 2.0 / (x * x + y * y + z * z + w * w)
+    xs, ys, zs = x * s, y * s, z * s
+    wx, wy, wz = w * xs, w * ys, w * zs
+    xx, xy, xz = x * xs, x * ys, x * zs
+    yy, yz, zz = y * ys, y * zs, z * zs
+    m0 = 1.0 - (yy + zz)
+    m4 = 1.0 - (xx + zz)
+    m8 = 1.0 - (xx + yy)
+    trace = m0 + m4 + m8
+    if trace > 0.0:
+        r = math.sqrt(trace + 1.0)
+        half = r * 0.5
+        r = 0.5 / r
+        return ((yz + wx - (yz - wx)) * r, (xz + wy - (xz - wy)) * r, (xy + wz - (xy - wz)) * r, half)
+    return _m_to_q((m0, xy - wz, xz + wy, xy + wz, m4, yz - wx, xz - wy, yz + wx, m8))
 
 
 def _slerp(a: Quat, b: Quat, t: float) -> Quat:

@@ -125,22 +125,21 @@ def _accumulate(links: list[Link], t: int) -> tuple[Vec, Quat] | None:
             else:
                 i = bisect_right(stamps, t) - 1
                 st = samples[i]
-                t0 = stamps[i]
-                if t0 != t and st[0] == samples[i + 1][0]:
+                if stamps[i] != t and st[0] == samples[i + 1][0]:
                     # between two samples of the same parent: interpolate as TimeCache.get_data
                     if st[0] != parent:
                         return None
-                    nw = samples[i + 1]
-                    theta, qx, qy, qz, qw, bx, by, bz, bw = intervals.get(i) or cache.interval(i)
-                    ratio = (t - t0) / (stamps[i + 1] - t0)
-                    keep = 1.0 - ratio
+                    theta, qx, qy, qz, qw, bx, by, bz, bw, t0, inv_dt, px, py, pz, dx, dy, dz = (
+                        intervals.get(i) or cache.interval(i)
+                    )
+                    ratio = (t - t0) * inv_dt
                     if theta != 0.0:
-                        s0 = sin(keep * theta)
+                        s0 = sin((1.0 - ratio) * theta)
                         s1 = sin(ratio * theta)
                         qx, qy, qz, qw = qx * s0 + bx * s1, qy * s0 + by * s1, qz * s0 + bz * s1, qw * s0 + bw * s1
-                    px = keep * st[1] + ratio * nw[1]
-                    py = keep * st[2] + ratio * nw[2]
-                    pz = keep * st[3] + ratio * nw[3]
+                    px += ratio * dx
+                    py += ratio * dy
+                    pz += ratio * dz
                     st = None
                     parent = -1  # marks "interpolated" for the check below
         if parent != -1:

@@ -219,3 +219,115 @@ def test_bad_action_server_arguments_are_refused():
         node.create_action_server(Fibonacci, "f", lambda gh: None, result_timeout=-1)
     with pytest.raises(TypeError, match="handle_accepted_callback must be callable"):
         node.create_action_server(Fibonacci, "f", lambda gh: None, handle_accepted_callback=3)
+
+
+class MockServer(Node):
+    """Accepts every goal, publishes feedback on demand, succeeds when told."""
+
+    def __init__(self):
+        super().__init__("mock_server")
+        self.finish = asyncio.Event()
+        self.handles = []
+        self.server = self.create_action_server(
+            Fibonacci, "fibonacci", self.execute, cancel_callback=lambda gh: CancelResponse.ACCEPT
+        )
+
+    async def execute(self, gh):
+        self.handles.append(gh)
+        await self.finish.wait()
+        if gh.is_cancel_requested:
+            gh.canceled()
+        else:
+            gh.succeed()
+        return Fibonacci.Result(sequence=[1])
+
+
+async def test_send_goal_multiple(runtime):
+    # rclpy rclpy/test/test_action_client.py::TestActionClient::test_send_goal_multiple
+    runtime.add_node(MockServer())
+    ac = runtime.add_node(Node("client")).create_action_client(
+        Fibonacci, "fibonacci", callback_group=ReentrantCallbackGroup()
+    )
+    assert await ac.wait_for_server(timeout_sec=2.0)
+    futures = [ac.send_goal_async(Fibonacci.Goal()) for _ in range(3)]
+    handles = [await f for f in futures]
+    assert all(f.done() and f.result().accepted for f in futures)
+    assert len({bytes(h.goal_id.uuid) for h in handles}) == 3
+
+
+async def test_send_cancel_async(runtime):
+    # rclpy rclpy/test/test_action_client.py::TestActionClient::test_send_cancel_async
+    server = runtime.add_node(MockServer())
+    ac = runtime.add_node(Node("client")).create_action_client(Fibonacci, "fibonacci")
+    assert await ac.wait_for_server(timeout_sec=2.0)
+    goal_future = ac.send_goal_async(Fibonacci.Goal())
+    goal_handle = await goal_future
+    cancel_future = goal_handle.cancel_goal_async()
+    await cancel_future
+    assert cancel_future.done()
+    assert cancel_future.result().goals_canceling[0].goal_id == goal_handle.goal_id
+    server.finish.set()
+    assert (await goal_handle.get_result_async()).status == GoalStatus.CANCELED
+
+
+async def test_get_result_async_and_goal_uuid(runtime):
+    # rclpy rclpy/test/test_action_client.py::TestActionClient::test_get_result_async (with goal_uuid=, as
+    # test_send_goal_async_with_feedback_after_goal passes it)
+    import uuid
+
+    from aiorobot.msgs.unique_identifier_msgs import UUID
+
+    server = runtime.add_node(MockServer())
+    server.finish.set()
+    ac = runtime.add_node(Node("client")).create_action_client(Fibonacci, "fibonacci")
+    assert await ac.wait_for_server(timeout_sec=2.0)
+    goal_uuid = UUID(uuid=uuid.uuid4().bytes)
+    goal_handle = await ac.send_goal_async(Fibonacci.Goal(), goal_uuid=goal_uuid)
+    assert goal_handle.goal_id == goal_uuid
+    result_future = goal_handle.get_result_async()
+    result = await result_future
+    assert result_future.done() and result.status == GoalStatus.SUCCEEDED and list(result.result.sequence) == [1]
+
+
+async def test_feedback_for_another_goal_or_after_the_result_is_ignored(runtime):
+    # rclpy test_action_client.py::test_send_goal_async_with_feedback_for_another_goal,
+    # ::test_send_goal_async_with_feedback_after_goal_result_requested
+    server = runtime.add_node(MockServer())
+    ac = runtime.add_node(Node("client")).create_action_client(Fibonacci, "fibonacci")
+    assert await ac.wait_for_server(timeout_sec=2.0)
+    seen_a, seen_b = [], []
+    a = await ac.send_goal_async(Fibonacci.Goal(order=1), feedback_callback=seen_a.append)
+    b = await ac.send_goal_async(Fibonacci.Goal(order=2), feedback_callback=seen_b.append)
+    await settle(runtime)
+    server_a = next(h for h in server.handles if h.request.order == 1)
+    server_a.publish_feedback(Fibonacci.Feedback(sequence=[7]))
+    await settle(runtime)
+    assert [list(m.feedback.sequence) for m in seen_a] == [[7]] and seen_b == []
+    server.finish.set()
+    await a.get_result_async()
+    await b.get_result_async()
+    # feedback published for goal a after its result: nobody hears it
+    server.server._feedback_pub.publish(
+        Fibonacci.FeedbackMessage(goal_id=a.goal_id, feedback=Fibonacci.Feedback(sequence=[8]))
+    )
+    await settle(runtime)
+    assert len(seen_a) == 1
+
+
+async def test_send_goal_async_without_a_server_fails_at_once(runtime):
+    # rclpy test_action_client.py::test_send_goal_async_no_server (a deliberate difference: see the doc)
+    from aiorobot import ServiceUnavailableError
+
+    ac = runtime.add_node(Node("client")).create_action_client(Fibonacci, "not_fibonacci")
+    future = ac.send_goal_async(Fibonacci.Goal())
+    with pytest.raises(ServiceUnavailableError, match="no action server for /not_fibonacci"):
+        await future
+
+
+async def test_action_client_different_type_raises(runtime):
+    # rclpy rclpy/test/test_action_client.py::TestActionClient::test_different_type_raises
+    ac = runtime.add_node(Node("client")).create_action_client(Fibonacci, "fibonacci")
+    with pytest.raises(TypeError):
+        await ac.send_goal("different goal type")
+    with pytest.raises(TypeError):
+        ac.send_goal_async("different goal type")

@@ -9,6 +9,7 @@ from aiorobot import Future, MutuallyExclusiveCallbackGroup, Node, ServiceError,
 from aiorobot._services import takes_response
 from aiorobot.msgs.example_interfaces import AddTwoInts
 from aiorobot.msgs.rcl_interfaces import GetParameters
+from aiorobot.msgs.std_srvs import Trigger
 
 
 async def test_concurrent_call_async_with_a_two_argument_handler(runtime):
@@ -140,3 +141,71 @@ async def test_cancelling_a_call_async_future_abandons_the_call(runtime):
     with pytest.raises(asyncio.CancelledError):
         await fut
     assert fut.cancelled() and fut.result() is None
+
+
+@pytest.mark.parametrize(
+    "service_name, namespace, expected",
+    [
+        ("service", None, "/service"),
+        ("example/service", None, "/example/service"),
+        ("service", "ns", "/ns/service"),
+        ("example/service", "ns", "/ns/example/service"),
+        ("example/service", "my/ns", "/my/ns/example/service"),
+        ("example/service", "/my/ns", "/my/ns/example/service"),
+        ("/service", "ns", "/service"),
+        ("/example/service", "ns", "/example/service"),
+    ],
+)
+def test_get_service_name(service_name, namespace, expected):
+    # rclpy rclpy/test/test_service.py::test_get_service_name (keyword names as rclpy's)
+    node = Node("node_name", namespace=namespace or "")
+    srv = node.create_service(srv_type=Trigger, srv_name=service_name, callback=lambda _: None)
+    cli = node.create_client(srv_type=Trigger, srv_name=service_name)
+    assert srv.service_name == expected and cli.service_name == expected
+    srv.destroy()
+
+
+@pytest.mark.parametrize(
+    "service_name, namespace, remap, expected",
+    [
+        ("service", None, {"service": "new_service"}, "/new_service"),
+        ("service", "ns", {"service": "new_service"}, "/ns/new_service"),
+        ("service", "ns", {"service": "example/new_service"}, "/ns/example/new_service"),
+        ("example/service", "ns", {"example/service": "new_service"}, "/ns/new_service"),
+    ],
+)
+def test_get_service_name_after_remapping(service_name, namespace, remap, expected):
+    # rclpy rclpy/test/test_service.py::test_get_service_name_after_remapping
+    node = Node("node_name", namespace=namespace or "", remappings=remap)
+    srv = node.create_service(srv_type=Trigger, srv_name=service_name, callback=lambda _: None)
+    assert srv.service_name == expected
+
+
+def test_service_context_manager():
+    # rclpy rclpy/test/test_service.py::test_service_context_manager
+    node = Node("ctx_mgr_test")
+    with node.create_service(srv_type=Trigger, srv_name="empty_service", callback=lambda _: None) as srv:
+        assert srv.service_name == "/empty_service"
+    assert srv not in node._services
+    with node.create_client(Trigger, "empty_service") as cli:
+        assert cli.service_name == "/empty_service"
+    assert cli.destroyed
+
+
+@pytest.mark.parametrize("factory", ["client", "service"])
+def test_create_client_and_service_validate_the_name(factory):
+    # rclpy rclpy/test/test_node.py::TestNode::test_create_client, ::test_create_service
+    node = Node("n")
+
+    def make(name):
+        if factory == "client":
+            return node.create_client(GetParameters, name)
+        return node.create_service(GetParameters, name, lambda req: None)
+
+    make("get/parameters")
+    with pytest.raises(ValueError, match=r"character '\?' is not allowed"):
+        make("get/parameters?")
+    with pytest.raises(ValueError, match="must not start with a digit"):
+        make("/get/42parameters")
+    with pytest.raises(ValueError, match="unknown substitution"):
+        make("foo/{bad_sub}")

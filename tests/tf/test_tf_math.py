@@ -169,3 +169,17 @@ def test_pq_round_trip():
 def test_bad_shapes_say_what_was_expected_and_received(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_canonical_fast_path_is_bit_identical_to_the_matrix_round_trip():
+    # the inlined common branch of _canonical does the same operations as _m_to_q(_q_to_m(q))
+    import random
+
+    from aiorobot.tf._math import _canonical, _m_to_q, _q_to_m
+
+    rng = random.Random(3)
+    for _ in range(20000):
+        q = [rng.gauss(0, 1) for _ in range(4)]
+        n = math.sqrt(sum(v * v for v in q))
+        q = tuple(v / n for v in q)
+        assert _canonical(q) == _m_to_q(_q_to_m(q))
