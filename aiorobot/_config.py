@@ -29,6 +29,7 @@ from ._names import expand_name, validate_namespace, validate_node_name
 
 __all__ = [
     "EXECUTORS",
+    "FoxgloveConfig",
     "LOG_LEVELS",
     "ConfigError",
     "GraphConfig",
@@ -56,9 +57,12 @@ _RUNTIME_KEYS = (
     "priority_realtime",
     "debug_messages",
     "parameters_file",
+    "record",
+    "foxglove",
 )
 _NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file")
-_RECORD_KEYS = ("path",)
+_RECORD_KEYS = ("path", "topics", "exclude", "compression", "max_bag_size", "max_bag_duration", "max_cache_size")
+_FOXGLOVE_KEYS = ("host", "port", "max_large_hz")
 _TOP_KEYS = ("runtime", "nodes", "record")
 
 _BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
@@ -145,9 +149,27 @@ class NodeConfig:
 
 @dataclass(frozen=True, slots=True)
 class RecordConfig:
-    """The ``[record]`` table (MCAP recording)."""
+    """The ``[record]`` table (or ``[runtime] record = {...}``): a rosbag2 (MCAP) recording of the run.
+
+    ``topics`` empty records every topic (``exclude``: a regular expression of topics not to).
+    """
 
     path: str
+    topics: tuple[str, ...] = ()
+    exclude: str = ""
+    compression: str = "none"
+    max_bag_size: int = 0
+    max_bag_duration: float = 0.0
+    max_cache_size: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class FoxgloveConfig:
+    """``[runtime] foxglove = true`` or ``{ port = 8765, host = "127.0.0.1", max_large_hz = 10 }``."""
+
+    host: str = "127.0.0.1"
+    port: int = 8765
+    max_large_hz: float = 10.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -158,6 +180,7 @@ class GraphConfig:
     runtime: RuntimeConfig
     nodes: tuple[NodeConfig, ...]
     record: RecordConfig | None = None
+    foxglove: FoxgloveConfig | None = None
 
     @property
     def base_dir(self) -> Path:
@@ -214,12 +237,15 @@ def parse_config(data: Mapping[str, Any], path: str | Path = "<config>") -> Grap
     runtime = _parse_runtime(checker, data.get("runtime", {}))
     nodes = _parse_nodes(checker, data)
     record = None
+    runtime_table = data.get("runtime", {})
+    if "record" in data and "record" in runtime_table:
+        raise checker.error("runtime.record", "the recording is set twice; keep either [record] or [runtime] record")
     if "record" in data:
-        record = _parse_record(checker, data["record"])
-        raise checker.error(
-            "record", "MCAP recording is not available yet; remove the [record] table"
-        )
-    return GraphConfig(path=str(path), runtime=runtime, nodes=nodes, record=record)
+        record = _parse_record(checker, data["record"], "record")
+    elif "record" in runtime_table:
+        record = _parse_record(checker, runtime_table["record"], "runtime.record")
+    foxglove = _parse_foxglove(checker, runtime_table["foxglove"]) if "foxglove" in runtime_table else None
+    return GraphConfig(path=str(path), runtime=runtime, nodes=nodes, record=record, foxglove=foxglove)
 
 
 def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
@@ -404,13 +430,51 @@ def _scalar_kind(value: Any) -> str | None:
     return None
 
 
-def _parse_record(checker: _Checker, table: Any) -> RecordConfig:
-    checker.check_type(table, "record", dict, "a table ([record])")
-    checker.check_keys(table, "record", _RECORD_KEYS)
+def _parse_record(checker: _Checker, table: Any, key: str) -> RecordConfig:
+    checker.check_type(table, key, dict, "a table such as { path = \"run\" }")
+    checker.check_keys(table, key, _RECORD_KEYS)
     if "path" not in table:
-        raise checker.error("record.path", 'missing required key; expected a file name such as "run.mcap"')
-    checker.check_type(table["path"], "record.path", str, "a file name string")
-    return RecordConfig(path=table["path"])
+        raise checker.error(f"{key}.path", 'missing required key; expected a bag directory name such as "run"')
+    checker.check_type(table["path"], f"{key}.path", str, "a directory name string")
+    topics = table.get("topics", [])
+    checker.check_type(topics, f"{key}.topics", list, "a list of topic names")
+    for i, topic in enumerate(topics):
+        checker.check_type(topic, f"{key}.topics[{i}]", str, "a topic name string")
+    exclude = table.get("exclude", "")
+    checker.check_type(exclude, f"{key}.exclude", str, "a regular expression string")
+    try:
+        re.compile(exclude)
+    except re.error as err:
+        raise checker.error(f"{key}.exclude", f"expected a regular expression, found {exclude!r} ({err})") from None
+    compression = checker.choice(table, key, "compression", ("none", "zstd", "lz4"), "none")
+    numbers = {}
+    for name, kind in (("max_bag_size", int), ("max_bag_duration", (int, float)), ("max_cache_size", int)):
+        value = table.get(name, 0)
+        checker.check_type(value, f"{key}.{name}", kind, "a number >= 0")
+        if value < 0:
+            raise checker.error(f"{key}.{name}", f"expected a number >= 0, found {value}")
+        numbers[name] = value
+    return RecordConfig(table["path"], tuple(topics), exclude, compression, int(numbers["max_bag_size"]),
+                        float(numbers["max_bag_duration"]), int(numbers["max_cache_size"]))
+
+
+def _parse_foxglove(checker: _Checker, value: Any) -> FoxgloveConfig | None:
+    key = "runtime.foxglove"
+    if isinstance(value, bool):
+        return FoxgloveConfig() if value else None
+    checker.check_type(value, key, dict, "true, false or a table such as { port = 8765 }")
+    checker.check_keys(value, key, _FOXGLOVE_KEYS)
+    host = value.get("host", "127.0.0.1")
+    checker.check_type(host, f"{key}.host", str, "an address string")
+    port = value.get("port", 8765)
+    checker.check_type(port, f"{key}.port", int, "a port number 0..65535")
+    if not 0 <= port <= 65535:
+        raise checker.error(f"{key}.port", f"expected a port number 0..65535, found {port}")
+    hz = value.get("max_large_hz", 10.0)
+    checker.check_type(hz, f"{key}.max_large_hz", (int, float), "a rate in Hz > 0")
+    if not hz > 0:
+        raise checker.error(f"{key}.max_large_hz", f"expected a rate in Hz > 0, found {hz}")
+    return FoxgloveConfig(host, port, float(hz))
 
 
 class _Checker:

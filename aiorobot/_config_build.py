@@ -45,6 +45,8 @@ def build_nodes(config: GraphConfig) -> list[tuple[Node, str]]:
     if base_dir not in sys.path:
         sys.path.insert(0, base_dir)
     built: list[tuple[Node, str]] = []
+    if config.record is not None:  # first, so it taps every publisher before its first message
+        built.append((_recorder(config), "main"))
     owners: dict[str, int] = {}
     for node_config in config.nodes:
         node = _construct(config, node_config)
@@ -58,7 +60,32 @@ def build_nodes(config: GraphConfig) -> list[tuple[Node, str]]:
             )
         owners[fqn] = node_config.index
         built.append((node, node_config.executor))
+    if config.foxglove is not None:
+        from aiorobot.foxglove import FoxgloveBridge
+
+        fox = config.foxglove
+        built.append((FoxgloveBridge(host=fox.host, port=fox.port, max_large_hz=fox.max_large_hz), "main"))
     return built
+
+
+def _recorder(config: GraphConfig) -> Node:
+    """The ``[record]`` table's Recorder node; a bag directory that exists already is a config error."""
+    from aiorobot.bag import BagError, Recorder
+
+    rec = config.record
+    assert rec is not None
+    try:
+        return Recorder(
+            path=rec.path,
+            topics=list(rec.topics),
+            exclude=rec.exclude,
+            compression=rec.compression,
+            max_bag_size=rec.max_bag_size,
+            max_bag_duration=rec.max_bag_duration,
+            max_cache_size=rec.max_cache_size,
+        )
+    except BagError as err:
+        raise ConfigError(config.path, "record.path", str(err)) from None
 
 
 def import_node_class(config: GraphConfig, node_config: NodeConfig) -> type[Node]:

@@ -192,9 +192,14 @@ namespace = "robot"
         ),
         (
             '[[nodes]]\nuse = "m:C"\n[record]\nfile = "x.mcap"\n',
-            'record.file: unknown key (expected one of: path)',
+            'record.file: unknown key (expected one of: path, topics, exclude, compression, max_bag_size, max_bag_duration, max_cache_size)',
         ),
-        ('[[nodes]]\nuse = "m:C"\n[record]\n', 'record.path: missing required key; expected a file name such as "run.mcap"'),
+        ('[[nodes]]\nuse = "m:C"\n[record]\n', 'record.path: missing required key; expected a bag directory name such as "run"'),
+        ('[[nodes]]\nuse = "m:C"\n[record]\npath = "r"\ncompression = "gzip"\n', 'record.compression: expected "none", "zstd" or "lz4", found "gzip"'),
+        ('[[nodes]]\nuse = "m:C"\n[record]\npath = "r"\nexclude = "(("\n', "record.exclude: expected a regular expression, found '((' (missing ), unterminated subpattern at position 1)"),
+        ('[runtime]\nrecord = { path = "a" }\n[[nodes]]\nuse = "m:C"\n[record]\npath = "b"\n', "runtime.record: the recording is set twice; keep either [record] or [runtime] record"),
+        ('[runtime]\nfoxglove = { port = 70000 }\n[[nodes]]\nuse = "m:C"\n', "runtime.foxglove.port: expected a port number 0..65535, found 70000"),
+        ('[runtime]\nfoxglove = "yes"\n[[nodes]]\nuse = "m:C"\n', 'runtime.foxglove: expected true, false or a table such as { port = 8765 }, found "yes"'),
         (
             '[[nodes]]\nuse = ":C"\n',
             'nodes[0].use: expected "module:Class" (a dotted module path, a colon, a class name), found ":C"',
