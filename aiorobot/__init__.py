@@ -71,6 +71,7 @@ _EXPORTS = {
     "ServerGoalHandle": "_actions",
     "Service": "_services",
     "ServiceError": "_errors",
+    "ShutdownTimeoutError": "_errors",
     "ServiceInfo": "_graph",
     "ServiceUnavailableError": "_services",
     "SetParametersResult": "_parameters",
@@ -143,6 +144,7 @@ __all__ = [
     "ServerGoalHandle",
     "Service",
     "ServiceError",
+    "ShutdownTimeoutError",
     "ServiceInfo",
     "ServiceUnavailableError",
     "SetParametersResult",
@@ -167,7 +169,7 @@ if TYPE_CHECKING:
     from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
     from ._errors import InvalidParameterTypeError, ParameterImmutableError, ParameterUninitializedError
-    from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
+    from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError, ShutdownTimeoutError
     from ._future import Future
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
     from ._node_graph import NodeNameNonExistentError
