@@ -251,7 +251,7 @@ def test_cache_headerless():
     cache = Cache(sub, 5, allow_headerless=False)
     cache.add(msg)
     assert cache.getElemAfterTime(Time()) is None
-    cache = Cache(sub, 5, allow_headerless=True)
+    cache = Cache(sub, 5, True)  # positional, as upstream allows
     cache.add(msg)
     assert cache.getElemAfterTime(Time()) is msg
     current = Time(nanoseconds=time.time_ns())
