@@ -231,10 +231,11 @@ class Client(_ServiceEndpoint):
     ``await client.call(request)`` is the asyncio way; ``client.call_async(request)``
     returns an rclpy-style :class:`~aiorobot.Future`.
 
-    rclpy difference: a call (``call`` or ``call_async``) when no server offers the
-    service fails at once with :class:`ServiceUnavailableError` instead of waiting
-    unanswered; wait with ``await client.wait_for_service()`` first, as rclpy's
-    examples do.
+    rclpy difference: ``call`` and ``wait_for_service`` are coroutines (rclpy's
+    block the calling thread), and a call (``call`` or ``call_async``) when no
+    server offers the service fails at once with :class:`ServiceUnavailableError`
+    instead of waiting unanswered; wait with ``await client.wait_for_service()``
+    first, as rclpy's examples do.
     """
 
     kind = "client"
