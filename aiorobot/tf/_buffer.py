@@ -76,10 +76,17 @@ class Buffer(BufferCore):
     Parameters
     ----------
     cache_time_sec
-        History kept per dynamic frame, in seconds.
+        History kept per dynamic frame, in seconds; a :class:`~aiorobot.Duration` works
+        too (tf2_ros's ``Buffer(cache_time)``).
+    cache_time
+        tf2_ros's keyword for the same, a Duration.
     """
 
-    def __init__(self, cache_time_sec: float = DEFAULT_CACHE_TIME_SEC) -> None:
+    def __init__(self, cache_time_sec: Any = DEFAULT_CACHE_TIME_SEC, *, cache_time: Any = None) -> None:
+        if cache_time is not None:
+            cache_time_sec = cache_time
+        if hasattr(cache_time_sec, "nanoseconds") and not isinstance(cache_time_sec, (int, float)):
+            cache_time_sec = cache_time_sec.nanoseconds / 1e9
         super().__init__(cache_time_sec)
         self._waiters_lock = threading.Lock()
         self._waiters: list[_Waiter] = []

@@ -72,3 +72,10 @@ def test_timeout_must_be_a_duration_or_seconds():
         b.lookup_transform("map", "base", Time(), timeout="1s")
     with pytest.raises(ValueError, match=r"^timeout: expected >= 0, got -1$"):
         b.can_transform("map", "base", Time(), timeout=-1)
+
+
+def test_buffer_takes_tf2_ros_cache_time_as_a_duration():
+    # tf2_ros buffer.py: Buffer(cache_time: Duration = None, node=None)
+    assert Buffer(Duration(seconds=5)).cache_time_sec == 5.0
+    assert Buffer(cache_time=Duration(seconds=2.5)).cache_time_sec == 2.5
+    assert Buffer(7.0).cache_time_sec == 7.0
