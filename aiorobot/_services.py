@@ -291,6 +291,10 @@ class Client(_ServiceEndpoint):
         self._check_request(request)
         return future_of(self.call(request), None if _in_loop() else self.node._loop)
 
+    def remove_pending_request(self, future: Future[Any]) -> None:
+        """Abandon a ``call_async`` request (rclpy's): its future is cancelled, a late reply dropped."""
+        future.cancel()
+
     async def call(self, request: Any, timeout_sec: float | None = None) -> Any:
         """Send ``request`` and return the response.
 
