@@ -216,7 +216,8 @@ def test_epsilon_policy_runs_in_a_synchronizer():
 
 def test_policy_names_are_checked():
     m0, m1 = SimpleFilter(), SimpleFilter()
-    with pytest.raises(ValueError, match=r"^ApproximateTimeSynchronizer: policy expected 'python' or 'cpp', got 'best'$"):
+    expected = r"^ApproximateTimeSynchronizer policy: expected 'python' \(the Python message_filters\) or 'cpp' "
+    with pytest.raises(ValueError, match=expected + r"\(the C\+\+ policy\), got 'best'$"):
         ApproximateTimeSynchronizer([m0, m1], 5, 0.1, policy="best")
     with pytest.raises(TypeError, match=r"needs the C\+\+ policy"):
         ApproximateTimeSynchronizer([m0, m1], 5, 0.1).set_inter_message_lower_bound(0, 0.1)
