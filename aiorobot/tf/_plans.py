@@ -120,10 +120,10 @@ def _accumulate(links: list[Link], t: int) -> tuple[Vec, Quat] | None:
         if stamps is None:
             st = cache.sample  # static
         else:
-            if len(stamps) < 2 or t > stamps[-1] or t < stamps[0]:
-                st, _ = cache.get_data(t)  # edges, single samples, errors: the general path
+            i = bisect_right(stamps, t) - 1
+            if not 0 <= i < len(stamps) - 1 or t == 0:
+                st, _ = cache.get_data(t)  # the last stamp, edges, time zero, errors: the general path
             else:
-                i = bisect_right(stamps, t) - 1
                 st = samples[i]
                 if stamps[i] != t and st[0] == samples[i + 1][0]:
                     # between two samples of the same parent: interpolate as TimeCache.get_data
