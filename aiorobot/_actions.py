@@ -634,10 +634,11 @@ class ActionClient:
         ``feedback_callback(feedback_message)`` gets each ``FeedbackMessage`` (as in rclpy);
         ``handle.feedback()`` yields the inner ``Feedback`` messages.
 
-        rclpy difference: ``feedback_callback`` may be ``async def``, and each call
-        runs as a task of its own (in a reentrant group), so a slow callback never
-        delays the goal's status, result or the next feedback; rclpy runs it in the
-        action client's callback group.
+        rclpy difference: a coroutine (rclpy's ``send_goal`` blocks the thread until
+        the goal's result; here ``await handle.result()`` does that part), and
+        ``feedback_callback`` may be ``async def``, each call running as a task of its
+        own (in a reentrant group), so a slow callback never delays the goal's status,
+        result or the next feedback; rclpy runs it in the action client's callback group.
         """
         from .msgs.unique_identifier_msgs import UUID
 

@@ -118,6 +118,10 @@ class NodeGraphMixin:
         """``(name, namespace)`` of every node in the graph (the root namespace is ``"/"``)."""
         return [(n.name, n.namespace or "/") for n in self.runtime.graph.nodes]
 
+    def get_node_names_and_namespaces_with_enclaves(self) -> list[tuple[str, str, str]]:
+        """``(name, namespace, enclave)`` of every node; aiorobot has no security enclaves, so ``"/"``."""
+        return [(name, namespace, "/") for name, namespace in self.get_node_names_and_namespaces()]
+
     def get_fully_qualified_node_names(self) -> list[str]:
         return [n.fully_qualified_name for n in self.runtime.graph.nodes]
 

@@ -231,10 +231,11 @@ class Client(_ServiceEndpoint):
     ``await client.call(request)`` is the asyncio way; ``client.call_async(request)``
     returns an rclpy-style :class:`~aiorobot.Future`.
 
-    rclpy difference: a call (``call`` or ``call_async``) when no server offers the
-    service fails at once with :class:`ServiceUnavailableError` instead of waiting
-    unanswered; wait with ``await client.wait_for_service()`` first, as rclpy's
-    examples do.
+    rclpy difference: ``call`` and ``wait_for_service`` are coroutines (rclpy's
+    block the calling thread), and a call (``call`` or ``call_async``) when no
+    server offers the service fails at once with :class:`ServiceUnavailableError`
+    instead of waiting unanswered; wait with ``await client.wait_for_service()``
+    first, as rclpy's examples do.
     """
 
     kind = "client"
@@ -289,6 +290,10 @@ class Client(_ServiceEndpoint):
         """
         self._check_request(request)
         return future_of(self.call(request), None if _in_loop() else self.node._loop)
+
+    def remove_pending_request(self, future: Future[Any]) -> None:
+        """Abandon a ``call_async`` request (rclpy's): its future is cancelled, a late reply dropped."""
+        future.cancel()
 
     async def call(self, request: Any, timeout_sec: float | None = None) -> Any:
         """Send ``request`` and return the response.

@@ -154,6 +154,20 @@ class Timer:
     def timer_period_ns(self) -> int:
         return self.period_ns
 
+    @timer_period_ns.setter
+    def timer_period_ns(self, value: int) -> None:
+        """Change the period (rclpy's setter): the grid restarts from now with the new period."""
+        if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+            raise ValueError(f"timer_period_ns: expected an int > 0 (nanoseconds), got {value!r}")
+        self.period_ns = value
+        if not self._cancelled:
+            self.reset()
+
+    def is_ready(self) -> bool:
+        """True when a call is due now (rclpy's ``is_ready``)."""
+        until = self.time_until_next_call()
+        return until is not None and until <= 0
+
     @property
     def clock(self) -> Clock:
         """The clock the timer runs on: the node's."""

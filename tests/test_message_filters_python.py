@@ -216,7 +216,8 @@ def test_epsilon_policy_runs_in_a_synchronizer():
 
 def test_policy_names_are_checked():
     m0, m1 = SimpleFilter(), SimpleFilter()
-    with pytest.raises(ValueError, match=r"^ApproximateTimeSynchronizer: policy expected 'python' or 'cpp', got 'best'$"):
+    expected = r"^ApproximateTimeSynchronizer policy: expected 'python' \(the Python message_filters\) or 'cpp' "
+    with pytest.raises(ValueError, match=expected + r"\(the C\+\+ policy\), got 'best'$"):
         ApproximateTimeSynchronizer([m0, m1], 5, 0.1, policy="best")
     with pytest.raises(TypeError, match=r"needs the C\+\+ policy"):
         ApproximateTimeSynchronizer([m0, m1], 5, 0.1).set_inter_message_lower_bound(0, 0.1)
@@ -251,7 +252,7 @@ def test_cache_headerless():
     cache = Cache(sub, 5, allow_headerless=False)
     cache.add(msg)
     assert cache.getElemAfterTime(Time()) is None
-    cache = Cache(sub, 5, allow_headerless=True)
+    cache = Cache(sub, 5, True)  # positional, as upstream allows
     cache.add(msg)
     assert cache.getElemAfterTime(Time()) is msg
     current = Time(nanoseconds=time.time_ns())
@@ -468,3 +469,56 @@ async def test_latest_time_synchronizer_on_sim_time_with_headerless_messages(sim
         await settle(sim_runtime)
         await sim_clock.advance(0.01)
     assert got == [(f"f{k}", f"s{k // 4 * 4}") for k in range(1, 8)]  # the slow one is held
+
+
+def _cache_msg(sec, data):
+    return MockMessage(Time(seconds=sec), data)
+
+
+def _fill_easy(cache, start, end):
+    for i in range(start, end):
+        cache.add(_cache_msg(i * 10, i))
+
+
+def test_cache_empty_surrounding_interval():
+    # message_filters test/msg_cache_unittest.cpp::Cache.emptySurroundingInterval
+    assert Cache(SimpleFilter(), 10).getSurroundingInterval(Time(seconds=5), Time(seconds=9)) == []
+
+
+def test_cache_easy_interval():
+    # message_filters test/msg_cache_unittest.cpp::Cache.easyInterval
+    cache = Cache(SimpleFilter(), 10)
+    _fill_easy(cache, 0, 5)
+    assert [m.data for m in cache.getInterval(Time(seconds=5), Time(seconds=35))] == [1, 2, 3]
+    assert cache.getInterval(Time(seconds=55), Time(seconds=65)) == []
+    _fill_easy(cache, 5, 20)  # the old ones fall off the back
+    assert cache.getInterval(Time(seconds=5), Time(seconds=35)) == []
+
+
+def test_cache_easy_surrounding_interval():
+    # message_filters test/msg_cache_unittest.cpp::Cache.easySurroundingInterval
+    cache = Cache(SimpleFilter(), 10)
+    _fill_easy(cache, 1, 6)
+    around = cache.getSurroundingInterval
+    assert [m.data for m in around(Time(seconds=15), Time(seconds=35))] == [1, 2, 3, 4]
+    assert [m.data for m in around(Time(seconds=0), Time(seconds=35))] == [1, 2, 3, 4]
+    assert [m.data for m in around(Time(seconds=35), Time(seconds=35))] == [3, 4]
+    assert [m.data for m in around(Time(seconds=55), Time(seconds=55))] == [5]
+
+
+def test_cache_easy_unsorted():
+    # message_filters test/msg_cache_unittest.cpp::Cache.easyUnsorted
+    cache = Cache(SimpleFilter(), 10)
+    for sec, data in ((10, 1), (30, 3), (70, 7), (5, 0), (20, 2)):
+        cache.add(_cache_msg(sec, data))
+    assert [m.data for m in cache.getInterval(Time(seconds=3), Time(seconds=15))] == [0, 1]
+    assert [m.data for m in cache.getInterval(Time(seconds=0), Time(seconds=80))] == [0, 1, 2, 3, 7]
+
+
+def test_cache_easy_elem_before_after():
+    # message_filters test/msg_cache_unittest.cpp::Cache.easyElemBeforeAfter
+    cache = Cache(SimpleFilter(), 10)
+    _fill_easy(cache, 5, 10)
+    assert cache.getElemAfterTime(Time(seconds=85)).data == 9
+    assert cache.getElemBeforeTime(Time(seconds=85)).data == 8
+    assert cache.getElemBeforeTime(Time(seconds=45)) is None

@@ -229,7 +229,7 @@ class Cache(SimpleFilter):
     arrive), so out-of-order input is answered correctly, as by the C++ ``Cache``.
     """
 
-    def __init__(self, input_filter: SimpleFilter | None = None, cache_size: int = 1, *, allow_headerless: bool = False) -> None:
+    def __init__(self, input_filter: SimpleFilter | None = None, cache_size: int = 1, allow_headerless: bool = False) -> None:
         super().__init__(input_filter.node if input_filter is not None else None)
         if isinstance(cache_size, bool) or not isinstance(cache_size, int) or cache_size < 1:
             raise ValueError(f"cache_size: expected an int >= 1, got {cache_size!r}")

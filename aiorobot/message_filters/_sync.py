@@ -25,7 +25,10 @@ def _check_slop(slop: Any) -> float:
 
 def _check_policy(owner: str, policy: str) -> None:
     if policy not in _POLICIES:
-        raise ValueError(f"{owner}: policy expected 'python' or 'cpp', got {policy!r}")
+        raise ValueError(
+            f"{owner} policy: expected 'python' (the Python message_filters) or 'cpp' (the C++ policy), "
+            f"got {policy!r}"
+        )
 
 
 _POLICIES = ("python", "cpp")

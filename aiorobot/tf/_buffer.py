@@ -21,7 +21,7 @@ from ._cache import display_time
 from ._conversions import check_supported
 from ._exceptions import ExtrapolationException, TransformException
 from ._math import _q_to_m
-from ._msgs import stamp_msg, time_ns
+from ._msgs import make_transform_stamped, stamp_msg, time_ns
 
 __all__ = ["Buffer"]
 
@@ -48,6 +48,20 @@ def _set_future(future: asyncio.Future[None], failure: TransformException | None
         future.set_exception(failure)
 
 
+def _timeout_seconds(timeout: Any) -> float:
+    """tf2_ros's ``timeout``: a Duration (anything with integer ``nanoseconds``) or a number of seconds."""
+    ns = getattr(timeout, "nanoseconds", None)
+    if isinstance(ns, int) and not isinstance(timeout, (int, float)):
+        seconds = ns / 1e9
+    elif isinstance(timeout, (int, float)) and not isinstance(timeout, bool):
+        seconds = float(timeout)
+    else:
+        raise TypeError(f"timeout: expected a Duration or a number of seconds, got {timeout!r}")
+    if seconds < 0:
+        raise ValueError(f"timeout: expected >= 0, got {timeout!r}")
+    return seconds
+
+
 def _check_timeout(timeout_sec: float | None) -> float | None:
     if timeout_sec is None:
         return None
@@ -62,10 +76,17 @@ class Buffer(BufferCore):
     Parameters
     ----------
     cache_time_sec
-        History kept per dynamic frame, in seconds.
+        History kept per dynamic frame, in seconds; a :class:`~aiorobot.Duration` works
+        too (tf2_ros's ``Buffer(cache_time)``).
+    cache_time
+        tf2_ros's keyword for the same, a Duration.
     """
 
-    def __init__(self, cache_time_sec: float = DEFAULT_CACHE_TIME_SEC) -> None:
+    def __init__(self, cache_time_sec: Any = DEFAULT_CACHE_TIME_SEC, *, cache_time: Any = None) -> None:
+        if cache_time is not None:
+            cache_time_sec = cache_time
+        if hasattr(cache_time_sec, "nanoseconds") and not isinstance(cache_time_sec, (int, float)):
+            cache_time_sec = cache_time_sec.nanoseconds / 1e9
         super().__init__(cache_time_sec)
         self._waiters_lock = threading.Lock()
         self._waiters: list[_Waiter] = []
@@ -276,6 +297,62 @@ class Buffer(BufferCore):
                 raise w.failure
         finally:
             self._unregister(w)
+
+    # ------------------------------------------------------------------ tf2_ros's blocking forms
+
+    def lookup_transform(self, target_frame: str, source_frame: str, time: Any, timeout: Any = None) -> Any:
+        """tf2_ros's ``lookup_transform``: as :meth:`BufferCore.lookup_transform`, and with ``timeout``
+        (a :class:`~aiorobot.Duration` or seconds) it first blocks this thread up to that long for the
+        data, then raises the tf exception if it is still missing. Blocking is refused on an event
+        loop thread: there, ``await lookup_transform_async(...)``.
+        """
+        if timeout is not None:
+            self._wait_blocking(_Waiter(target_frame, source_frame, time_ns(time)), _timeout_seconds(timeout))
+        # BufferCore.lookup_transform's two lines, not a super() call: this is the hot path
+        t_out, vec, q = self._lookup_raw(target_frame, source_frame, time_ns(time), "lookup_transform")
+        return make_transform_stamped(target_frame, source_frame, t_out, vec, q)
+
+    def lookup_transform_full(
+        self,
+        target_frame: str,
+        target_time: Any,
+        source_frame: str,
+        source_time: Any,
+        fixed_frame: str,
+        timeout: Any = None,
+    ) -> Any:
+        """tf2_ros's ``lookup_transform_full``, with ``timeout`` as in :meth:`lookup_transform`."""
+        if timeout is not None:
+            full = (time_ns(target_time), time_ns(source_time), fixed_frame)
+            self._wait_blocking(_Waiter(target_frame, source_frame, full[0], full=full), _timeout_seconds(timeout))
+        return super().lookup_transform_full(target_frame, target_time, source_frame, source_time, fixed_frame)
+
+    def can_transform(  # type: ignore[override]
+        self, target_frame: str, source_frame: str, time: Any, timeout: Any = None, return_debug_tuple: bool = False
+    ) -> bool | tuple[bool, str]:
+        """tf2_ros's ``can_transform``: never raises for tf errors; ``timeout`` first blocks this thread
+        up to that long for the data (not on an event loop thread)."""
+        if timeout is not None:
+            self._wait_blocking(_Waiter(target_frame, source_frame, time_ns(time)), _timeout_seconds(timeout))
+        return super().can_transform(target_frame, source_frame, time, return_debug_tuple=return_debug_tuple)
+
+    def can_transform_full(  # type: ignore[override]
+        self,
+        target_frame: str,
+        target_time: Any,
+        source_frame: str,
+        source_time: Any,
+        fixed_frame: str,
+        timeout: Any = None,
+        return_debug_tuple: bool = False,
+    ) -> bool | tuple[bool, str]:
+        """tf2_ros's ``can_transform_full``, with ``timeout`` as in :meth:`can_transform`."""
+        if timeout is not None:
+            full = (time_ns(target_time), time_ns(source_time), fixed_frame)
+            self._wait_blocking(_Waiter(target_frame, source_frame, full[0], full=full), _timeout_seconds(timeout))
+        return super().can_transform_full(
+            target_frame, target_time, source_frame, source_time, fixed_frame, return_debug_tuple=return_debug_tuple
+        )
 
     # ------------------------------------------------------------------ transforming data
 

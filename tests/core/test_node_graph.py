@@ -73,6 +73,11 @@ def test_node_names_and_namespaces(runtime, node):
     assert sorted(node.get_node_names()) == ["my_node", "root_node"]
     assert sorted(node.get_node_names_and_namespaces()) == [("my_node", "/my_ns"), ("root_node", "/")]
     assert sorted(node.get_fully_qualified_node_names()) == ["/my_ns/my_node", "/root_node"]
+    # rclpy test_node.py::TestNode::test_node_names_and_namespaces_with_enclaves
+    assert sorted(node.get_node_names_and_namespaces_with_enclaves()) == [
+        ("my_node", "/my_ns", "/"),
+        ("root_node", "/", "/"),
+    ]
 
 
 def test_service_and_client_names_and_types_by_node(runtime, node):

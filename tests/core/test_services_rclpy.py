@@ -209,3 +209,21 @@ def test_create_client_and_service_validate_the_name(factory):
         make("/get/42parameters")
     with pytest.raises(ValueError, match="unknown substitution"):
         make("foo/{bad_sub}")
+
+
+async def test_remove_pending_request_abandons_the_call(runtime):
+    # rclpy client.py: Client.remove_pending_request(future)
+    node = runtime.add_node(Node("node"))
+    release = asyncio.Event()
+
+    async def slow(req):
+        await release.wait()
+        return AddTwoInts.Response(sum=1)
+
+    node.create_service(AddTwoInts, "slow", slow)
+    cli = node.create_client(AddTwoInts, "slow")
+    fut = cli.call_async(AddTwoInts.Request())
+    await asyncio.sleep(0)
+    cli.remove_pending_request(fut)
+    release.set()
+    assert fut.cancelled() and fut.result() is None

@@ -104,3 +104,16 @@ async def test_destroy_rate(runtime):
     node.destroy_rate(rate)
     with pytest.raises(RuntimeError, match="was destroyed"):
         await rate.sleep()
+
+
+async def test_changing_the_period_and_is_ready(sim_runtime, sim_clock):
+    # rclpy timer.py: Timer.timer_period_ns setter, Timer.is_ready
+    node = sim_runtime.add_node(Node("n"))
+    ticks = []
+    timer = node.create_timer(1, lambda: ticks.append(node.now().nanoseconds))
+    assert not timer.is_ready()
+    timer.timer_period_ns = 250_000_000  # restarts the grid from now (t = 1 s)
+    await sim_clock.advance(0.6, step_sec=0.05)
+    assert ticks == [1_250_000_000, 1_500_000_000]
+    with pytest.raises(ValueError, match="expected an int > 0"):
+        timer.timer_period_ns = 0

@@ -97,3 +97,11 @@ def test_errors_after_a_cached_lookup_are_tf2s():
     b.clear()
     with pytest.raises((ExtrapolationException, LookupException)):
         b.lookup_transform("odom", "base", Time(seconds=1.5))
+
+
+def test_time_zero_on_a_dynamic_link_stamped_zero_means_the_latest():
+    # tf2: time zero is "the latest"; a replayed walk must not read it as the stamp 0
+    b = Buffer()
+    b.set_transform(tf("odom", "base", 0, (1, 0, 0)), "t")
+    for _ in range(2):  # traced, then replayed
+        assert xyz_of(b.lookup_transform("odom", "base", Time()))[0] == pytest.approx(1)
