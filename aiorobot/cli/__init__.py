@@ -19,6 +19,7 @@ __all__ = ["COMMANDS", "main"]
 COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config (default: the bundled example)"),
     "bench": ("aiorobot.bench._cli", "executor and transport latency benchmark"),
+    "sim": ("aiorobot.cli._sim", "run the simulated robot in a world (lidar, IMU, odometry, camera)"),
 }
 
 

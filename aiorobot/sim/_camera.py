@@ -129,7 +129,11 @@ class MarkerRenderer:
                                         cv2.BORDER_CONSTANT, value=255)
             self._textures.append(np.ascontiguousarray(np.repeat(padded[:, :, None], 3, axis=2)))
             self._margins.append(lm.size / cells)
-        self._corners = [lm.corners_with_margin(m) for lm, m in zip(self.landmarks, self._margins)]
+        self._all_corners = np.array(
+            [lm.corners_with_margin(m) for lm, m in zip(self.landmarks, self._margins)]
+        ).reshape(-1, 4, 3)
+        self._centres = np.array([(lm.x, lm.y) for lm in self.landmarks]).reshape(-1, 2)
+        self._normals = np.array([(math.cos(lm.yaw), math.sin(lm.yaw)) for lm in self.landmarks]).reshape(-1, 2)
         self._background: NDArray[np.uint8] | None = None
 
     def __repr__(self) -> str:
@@ -167,18 +171,23 @@ class MarkerRenderer:
         else:
             np.copyto(image, self.background())
         position = pose[:3, 3]
-        drawn: list[tuple[float, int]] = []
-        for index, lm in enumerate(self.landmarks):
-            if not _faces(lm, position):
-                continue
-            corners = _to_optical(self._corners[index], pose)
-            if np.any(corners[:, 2] < _NEAR_M):
-                continue
-            drawn.append((float(corners[:, 2].mean()), index))
+        facing = (position[0] - self._centres[:, 0]) * self._normals[:, 0] + (
+            position[1] - self._centres[:, 1]
+        ) * self._normals[:, 1] > 1e-9
         ids: list[int] = []
-        for _, index in sorted(drawn, reverse=True):
+        candidates = np.flatnonzero(facing)
+        if candidates.size == 0:
+            return image, ids
+        optical = (self._all_corners[candidates] - position) @ pose[:3, :3]  # (k, 4, 3)
+        in_front = np.all(optical[:, :, 2] >= _NEAR_M, axis=1)
+        candidates, optical = candidates[in_front], optical[in_front]
+        z = optical[:, :, 2]
+        pixels_all = np.stack([cam.fx * optical[:, :, 0] / z + cam.cx, cam.fy * optical[:, :, 1] / z + cam.cy], axis=2)
+        order = np.argsort(-z.mean(axis=1), kind="stable")  # far to near
+        for k in order:
+            index = int(candidates[k])
             lm = self.landmarks[index]
-            pixels = cam.project(_to_optical(self._corners[index], pose))
+            pixels = pixels_all[k]
             x0 = max(int(math.floor(pixels[:, 0].min())), 0)
             y0 = max(int(math.floor(pixels[:, 1].min())), 0)
             x1 = min(int(math.ceil(pixels[:, 0].max())) + 1, cam.width)

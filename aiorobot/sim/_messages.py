@@ -25,12 +25,20 @@ def odometry_message(stamp: Any, frame_id: str, child_frame_id: str, pose: NDArr
     msg.pose.pose.position.y = float(pose[1])
     msg.pose.pose.orientation.z = math.sin(0.5 * pose[2])
     msg.pose.pose.orientation.w = math.cos(0.5 * pose[2])
-    msg.pose.covariance = np.diag([pose_variance[0], pose_variance[1], 1e-9, 1e-9, 1e-9, pose_variance[2]]).reshape(36)
+    msg.pose.covariance = _covariance6(pose_variance)
     msg.twist.twist.linear.x = float(twist[0])
     msg.twist.twist.linear.y = float(twist[1])
     msg.twist.twist.angular.z = float(twist[2])
-    msg.twist.covariance = np.diag([twist_variance[0], twist_variance[1], 1e-9, 1e-9, 1e-9, twist_variance[2]]).reshape(36)
+    msg.twist.covariance = _covariance6(twist_variance)
     return msg
+
+
+def _covariance6(planar: tuple[float, float, float]) -> NDArray[np.float64]:
+    """Row-major 6x6 diagonal: x, y, yaw from ``planar``; z, roll, pitch a tiny fixed variance."""
+    cov = np.zeros(36)
+    cov[0], cov[7], cov[35] = planar
+    cov[14] = cov[21] = cov[28] = 1e-9
+    return cov
 
 
 def static_transform(parent: str, child: str, xyz: tuple[float, float, float],

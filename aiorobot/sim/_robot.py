@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aiorobot.control import DiffDrive, Kinematics, Mecanum, integrate_twist
+from aiorobot.control import DiffDrive, Kinematics, Mecanum
 
 from ._world import World
 
@@ -20,6 +20,22 @@ __all__ = ["RobotBody", "make_kinematics"]
 
 #: A robot touching a wall stays "in contact" (one collision) until it is this far from it.
 _CONTACT_MARGIN_M = 0.02
+
+
+def integrate_twist(pose: NDArray[np.float64], twist: NDArray[np.float64], dt_sec: float) -> NDArray[np.float64]:
+    """``aiorobot.control.integrate_twist`` (exact arc) on plain floats: the simulator calls it every step."""
+    x, y, theta = float(pose[0]), float(pose[1]), float(pose[2])
+    vx, vy, omega = float(twist[0]), float(twist[1]), float(twist[2])
+    phi = omega * dt_sec
+    if abs(phi) < 1e-6:
+        phi2 = phi * phi
+        a, b = dt_sec * (1.0 - phi2 / 6.0), dt_sec * (phi / 2.0 - phi * phi2 / 24.0)
+    else:
+        a, b = dt_sec * math.sin(phi) / phi, dt_sec * (1.0 - math.cos(phi)) / phi
+    dx, dy = a * vx - b * vy, b * vx + a * vy
+    c, s = math.cos(theta), math.sin(theta)
+    yaw = (theta + phi + math.pi) % (2.0 * math.pi) - math.pi
+    return np.array([x + c * dx - s * dy, y + s * dx + c * dy, yaw])
 
 
 def make_kinematics(robot: str, *, wheel_radius: float = 0.05, wheel_separation: float = 0.3,
@@ -107,7 +123,13 @@ class RobotBody:
         """Advance ``dt_sec``: ramp the velocity toward the command, move, stop at walls, integrate odometry."""
         if dt_sec <= 0.0:
             return
-        before = self.twist.copy()
+        before = self.twist
+        if not (self.velocity.any() or self.command.any()):  # parked: nothing moves, nothing drifts
+            self.twist = np.zeros(3)
+            self.acceleration = np.zeros(2)
+            self.wheel_velocities = np.zeros(self.kinematics.n_wheels)
+            self.odom_twist = np.zeros(3)
+            return
         limit = self.max_acceleration * dt_sec
         self.velocity = self.velocity + np.clip(self.command - self.velocity, -limit, limit)
         twist = self.velocity * (1.0 - self.wheel_slip)

@@ -172,6 +172,8 @@ class Simulator(Node):
         self.imu = ImuModel(gyro_noise_std=noise["gyro_noise_std"], gyro_bias_std=noise["gyro_bias_std"],
                             gyro_bias_walk_std=noise["gyro_bias_walk_std"], accel_noise_std=noise["accel_noise_std"],
                             rng=self._rng_imu)
+        self._gyro_covariance = np.eye(3).reshape(9) * max(self.imu.gyro_noise_std, 1e-6) ** 2
+        self._accel_covariance = np.eye(3).reshape(9) * max(self.imu.accel_noise_std, 1e-6) ** 2
         self.camera = CameraModel()
         self._renderer: MarkerRenderer | None = None
         self._streams = {name: _Stream(name, rate) for name, rate in rates.items()}
@@ -243,6 +245,7 @@ class Simulator(Node):
         stamp = self._stamp()
         self._publish_static(stamp)
         self.map_pub.publish(occupancy_grid_message(self.world, stamp, FRAMES["map"]))
+        self._warm_up()
         lockstep = self.real_time_factor == 0.0
         if lockstep:
             await settle(runtime)
@@ -270,6 +273,13 @@ class Simulator(Node):
             if end_ns is not None and self.time_ns >= end_ns:
                 runtime.shutdown()
                 return
+
+    def _warm_up(self) -> None:
+        """Load the compiled kernels and marker textures now, not on the first due sample."""
+        x, y, yaw = self.body.pose
+        raycast(self.world.occupied, self.world.resolution, self.world.origin[:2], (x, y), self.lidar.angles[:1])
+        if self._streams["camera"].next_ns is not None and self._renderer is None:
+            self._renderer = MarkerRenderer(self.world.landmarks, self.camera)
 
     def step_to(self, target_ns: int) -> None:
         """Advance the world to ``target_ns``, publish ``/clock`` and every stream that is due."""
@@ -331,10 +341,8 @@ class Simulator(Node):
         msg.orientation_covariance[0] = -1.0  # no orientation estimate (sensor_msgs/Imu convention)
         msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in gyro)
         msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = (float(v) for v in accel)
-        g2 = max(self.imu.gyro_noise_std, 1e-6) ** 2
-        a2 = max(self.imu.accel_noise_std, 1e-6) ** 2
-        msg.angular_velocity_covariance = np.diag([g2, g2, g2]).reshape(9)
-        msg.linear_acceleration_covariance = np.diag([a2, a2, a2]).reshape(9)
+        msg.angular_velocity_covariance = self._gyro_covariance.copy()
+        msg.linear_acceleration_covariance = self._accel_covariance.copy()
         self.imu_pub.publish(msg)
 
     def _publish_odom(self, stamp: Any) -> None:

@@ -165,3 +165,15 @@ def test_odometry_drifts_by_its_scale_error_while_truth_slips() -> None:
     assert body.odom_pose[0] == pytest.approx(0.2 * 5 * 1.05)
     # the wheels turned what the command asked: r * angle = distance
     np.testing.assert_allclose(body.wheel_positions * 0.05, [1.0, 1.0, 1.0, 1.0])
+
+
+def test_the_simulators_fast_arc_matches_the_control_package() -> None:
+    from aiorobot.control import integrate_twist as reference
+    from aiorobot.sim._robot import integrate_twist
+
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        pose, twist, dt = rng.normal(size=3), rng.normal(size=3), float(rng.uniform(0, 0.1))
+        np.testing.assert_allclose(integrate_twist(pose, twist, dt), reference(pose, twist, dt), atol=1e-12)
+    np.testing.assert_allclose(integrate_twist(np.zeros(3), np.array([1.0, 0.0, 1e-9]), 0.01),
+                               reference(np.zeros(3), np.array([1.0, 0.0, 1e-9]), 0.01), atol=1e-12)
