@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from ._builtin import CAMERA_HEIGHT_M, make_box, make_warehouse
 from ._camera import OPTICAL_FROM_LINK, CameraModel, MarkerRenderer, camera_pose_matrix, project_landmark
-from ._raycast import raycast
+from ._raycast import clearance_map, raycast
 from ._robot import RobotBody, make_kinematics
 from ._sensors import GRAVITY, ImuModel, LidarModel
 from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TOPICS, Simulator
@@ -40,6 +40,7 @@ __all__ = [
     "WorldError",
     "builtin_world_path",
     "camera_pose_matrix",
+    "clearance_map",
     "load_world",
     "make_box",
     "make_kinematics",

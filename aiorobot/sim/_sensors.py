@@ -41,6 +41,7 @@ class LidarModel:
     noise_std: float = 0.01
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "_angles", self.angle_min + self.angle_increment * np.arange(self.beams))
         if isinstance(self.beams, bool) or not isinstance(self.beams, int) or self.beams <= 0:
             raise ValueError(f"beams: expected an int > 0, found {self.beams!r}")
         _non_negative("scan_noise_std", self.noise_std)
@@ -58,16 +59,16 @@ class LidarModel:
     @property
     def angles(self) -> NDArray[np.float64]:
         """Beam angles in the laser frame, shape (beams,)."""
-        return self.angle_min + self.angle_increment * np.arange(self.beams)
+        return self._angles.copy()
 
     def measure(self, world: World, x: float, y: float, yaw: float, rng: np.random.Generator) -> NDArray[np.float32]:
         """Ranges (m, float32) seen from a laser at ``(x, y)`` looking along ``yaw``."""
-        ranges = raycast(world.occupied, world.resolution, world.origin[:2], (x, y), self.angles + yaw, self.range_max)
-        hit = np.isfinite(ranges)
+        ranges = raycast(world.occupied, world.resolution, world.origin[:2], (x, y), self._angles + yaw, self.range_max,
+                         clearance=world.clearance)
         if self.noise_std > 0.0:
-            ranges[hit] += rng.normal(0.0, self.noise_std, int(hit.sum()))
-        ranges[hit & (ranges > self.range_max)] = np.inf
-        ranges[hit & (ranges < self.range_min)] = -np.inf
+            ranges += rng.normal(0.0, self.noise_std, ranges.shape[0])  # inf stays inf
+        ranges[ranges > self.range_max] = np.inf
+        ranges[ranges < self.range_min] = -np.inf
         return ranges.astype(np.float32)
 
 

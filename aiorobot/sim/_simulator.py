@@ -277,7 +277,9 @@ class Simulator(Node):
     def _warm_up(self) -> None:
         """Load the compiled kernels and marker textures now, not on the first due sample."""
         x, y, yaw = self.body.pose
-        raycast(self.world.occupied, self.world.resolution, self.world.origin[:2], (x, y), self.lidar.angles[:1])
+        world = self.world
+        raycast(world.occupied, world.resolution, world.origin[:2], (x, y), self.lidar.angles[:1])
+        raycast(world.occupied, world.resolution, world.origin[:2], (x, y), self.lidar.angles[:1], clearance=world.clearance)
         if self._streams["camera"].next_ns is not None and self._renderer is None:
             self._renderer = MarkerRenderer(self.world.landmarks, self.camera)
 
@@ -399,7 +401,7 @@ class Simulator(Node):
         dx, dy = landmark.x - position[0], landmark.y - position[1]
         distance = math.hypot(dx, dy)
         hit = raycast(world.occupied, world.resolution, world.origin[:2], (position[0], position[1]),
-                      np.array([math.atan2(dy, dx)]), distance + 1.0)[0]
+                      np.array([math.atan2(dy, dx)]), distance + 1.0, clearance=world.clearance)[0]
         return bool(hit >= distance - 1.5 * world.resolution)
 
     def _publish_camera(self, stamp: Any) -> None:

@@ -98,6 +98,7 @@ class World:
     start: tuple[float, float, float] = (0.0, 0.0, 0.0)
     path: str = ""
     occupied: NDArray[np.uint8] = field(init=False, repr=False)
+    _clearance: NDArray[np.float32] | None = field(init=False, repr=False, default=None)
 
     def __post_init__(self) -> None:
         # What blocks rays and the robot: occupied cells (unknown counts as free space to drive).
@@ -109,6 +110,16 @@ class World:
             f"<World {self.name} {w}x{h} cells at {self.resolution:g} m "
             f"({self.width_m:g} x {self.height_m:g} m) landmarks={len(self.landmarks)}>"
         )
+
+    @property
+    def clearance(self) -> NDArray[np.float32]:
+        """:func:`~aiorobot.sim.clearance_map` of :attr:`occupied` (computed once): lets rays leap."""
+        if self._clearance is None:
+            from ._raycast import clearance_map
+
+            object.__setattr__(self, "_clearance", clearance_map(self.occupied))
+        assert self._clearance is not None
+        return self._clearance
 
     @property
     def width_m(self) -> float:

@@ -177,3 +177,18 @@ def test_the_simulators_fast_arc_matches_the_control_package() -> None:
         np.testing.assert_allclose(integrate_twist(pose, twist, dt), reference(pose, twist, dt), atol=1e-12)
     np.testing.assert_allclose(integrate_twist(np.zeros(3), np.array([1.0, 0.0, 1e-9]), 0.01),
                                reference(np.zeros(3), np.array([1.0, 0.0, 1e-9]), 0.01), atol=1e-12)
+
+
+def test_leaping_through_open_space_gives_the_same_distances() -> None:
+    from aiorobot.sim import clearance_map
+
+    rng = np.random.default_rng(21)
+    grid = (rng.random((120, 150)) < 0.01).astype(np.uint8)
+    grid[:2], grid[-2:], grid[:, :2], grid[:, -2:] = 1, 1, 1, 1
+    clearance = clearance_map(grid)
+    angles = rng.uniform(-math.pi, math.pi, 200)
+    for _ in range(20):
+        x, y = rng.uniform(0.2, 7.3), rng.uniform(0.2, 5.8)
+        plain = raycast(grid, 0.05, (0.0, 0.0), (x, y), angles, 12.0)
+        leaping = raycast(grid, 0.05, (0.0, 0.0), (x, y), angles, 12.0, clearance=clearance)
+        np.testing.assert_allclose(leaping, plain, atol=1e-9)
