@@ -150,6 +150,10 @@ class World:
         r1 = math.floor((y + radius - oy) / res)
         if c0 < 0 or r0 < 0 or c1 >= w or r1 >= h:
             return False
+        # fast path: every point of the centre's cell is >= (clearance - sqrt 2) cells from any obstacle
+        row, col = math.floor((y - oy) / res), math.floor((x - ox) / res)
+        if (float(self.clearance[row, col]) - 1.4143) * res > radius:
+            return True
         block = self.occupied[r0 : r1 + 1, c0 : c1 + 1]
         if not block.any():
             return True

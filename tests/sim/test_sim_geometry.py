@@ -192,3 +192,23 @@ def test_leaping_through_open_space_gives_the_same_distances() -> None:
         plain = raycast(grid, 0.05, (0.0, 0.0), (x, y), angles, 12.0)
         leaping = raycast(grid, 0.05, (0.0, 0.0), (x, y), angles, 12.0, clearance=clearance)
         np.testing.assert_allclose(leaping, plain, atol=1e-9)
+
+
+def test_free_disc_fast_path_agrees_with_the_cell_check() -> None:
+    world = World.load("warehouse")
+    rng = np.random.default_rng(2)
+    for _ in range(300):
+        x, y, r = rng.uniform(-10.4, 10.4), rng.uniform(-7.4, 7.4), rng.uniform(0.05, 1.0)
+        exact = world.is_free_disc(x, y, r)
+        ox, oy, _ = world.origin
+        res = world.resolution
+        c0, c1 = math.floor((x - r - ox) / res), math.floor((x + r - ox) / res)
+        r0, r1 = math.floor((y - r - oy) / res), math.floor((y + r - oy) / res)
+        h, w = world.occupied.shape
+        if c0 < 0 or r0 < 0 or c1 >= w or r1 >= h:
+            assert not exact
+            continue
+        rows, cols = np.nonzero(world.occupied[r0 : r1 + 1, c0 : c1 + 1])
+        cx0, cy0 = ox + (cols + c0) * res, oy + (rows + r0) * res
+        dx, dy = np.clip(x, cx0, cx0 + res) - x, np.clip(y, cy0, cy0 + res) - y
+        assert exact == bool(np.all(dx * dx + dy * dy > r * r))
