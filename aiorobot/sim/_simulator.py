@@ -149,6 +149,15 @@ class Simulator(Node):
             p("max_angular_accel", 4.0, description="rad/s^2", range=(1e-3, 1000.0), read_only=True).value,
         )
         self.publish_odom_tf = p("publish_odom_tf", False, description="broadcast odom -> base_link", read_only=True).value
+        self.drive = p("drive", "cmd_vel", description="cmd_vel: follow /cmd_vel; serial: wheels from a simulated "
+                       "motor firmware on a pty (pair with SerialMotorBridge + a base controller)", read_only=True).value
+        self.port_link = p("port_link", "/tmp/aiorobot-sim-motors", description="pty symlink for drive = serial",
+                           read_only=True).value
+        if self.drive not in ("cmd_vel", "serial"):
+            raise ValueError(f"drive: expected 'cmd_vel' or 'serial', found {self.drive!r}")
+        if self.drive == "serial" and rtf == 0.0:
+            raise ValueError("drive = 'serial' needs real_time_factor > 0: the pty link runs on the wall clock "
+                             "and cannot be stepped in lock-step; set real_time_factor = 1.0")
 
         if not 0.0 <= noise["wheel_slip"] < 1.0:
             raise ValueError(f"wheel_slip: expected a fraction in [0, 1), found {noise['wheel_slip']!r}")
@@ -194,8 +203,9 @@ class Simulator(Node):
         # Reliable publishers connect to reliable and best-effort subscriptions alike.
         sensor = QoSProfile(depth=10)
         self.clock_pub = self.create_publisher(Clock, "/clock", QoSProfile(depth=1))
-        self.odom_pub = self.create_publisher(Odometry, "/odom", 10)
-        self.joint_pub = self.create_publisher(JointState, "/joint_states", 10)
+        # with drive = serial the bridge publishes /joint_states and a base controller /odom
+        self.odom_pub = self.create_publisher(Odometry, "/odom", 10) if self.drive == "cmd_vel" else None
+        self.joint_pub = self.create_publisher(JointState, "/joint_states", 10) if self.drive == "cmd_vel" else None
         self.imu_pub = self.create_publisher(Imu, "/imu/data", sensor)
         self.scan_pub = self.create_publisher(LaserScan, "/scan", sensor)
         self.image_pub = self.create_publisher(Image, "/camera/image_raw", sensor)
@@ -204,7 +214,14 @@ class Simulator(Node):
         self.map_pub = self.create_publisher(
             OccupancyGrid, "/map", QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         )
-        self.create_subscription(Twist, "/cmd_vel", self.on_cmd_vel, 10)
+        self.pty: Any = None
+        if self.drive == "cmd_vel":
+            self.create_subscription(Twist, "/cmd_vel", self.on_cmd_vel, 10)
+        else:
+            from aiorobot.control import PtyFirmware, SimulatedFirmware
+
+            firmware = SimulatedFirmware(wheel_count=self.kinematics.n_wheels)
+            self.pty = PtyFirmware(firmware, link_path=self.port_link, clock=lambda: self.time_ns / _NS)
         import aiorobot.tf as tf
 
         self._static_tf = tf.StaticTransformBroadcaster(self)
@@ -234,7 +251,16 @@ class Simulator(Node):
                 "the runtime does not use sim time: other nodes will not follow /clock; "
                 "set [runtime] use_sim_time = true"
             )
+        if self.pty is not None:
+            self.pty.open()
+            self.pty.attach()
+            self.get_logger().info(f"simulated motor firmware on {self.pty.slave_path} (linked at {self.port_link})")
         self._task = self._create_task(self._run(), name="simulator loop")
+
+    async def on_shutdown(self) -> None:
+        if self.pty is not None:
+            self.pty.drain()
+            self.pty.close_pty()
 
     async def _run(self) -> None:
         from aiorobot.testing import settle
@@ -293,15 +319,19 @@ class Simulator(Node):
         ):
             self.body.set_command((0.0, 0.0, 0.0))
             self._last_cmd_ns = None
+        if self.pty is not None and self.pty.is_open:
+            self.body.set_wheel_speeds(self.pty.firmware.speed_rad_s)
         self.body.step(dt, self.world)
         self.time_ns = target_ns
+        if self.pty is not None and self.pty.is_open:
+            self.pty.pump()  # the firmware integrates its motors to the new sim time and reports ticks
         self.steps += 1
         self._publish_clock()
         stamp = self._stamp()
         streams = self._streams
         if streams["imu"].due(target_ns):
             self._publish_imu(stamp, streams["imu"].period_ns / _NS)
-        if streams["odom"].due(target_ns):
+        if streams["odom"].due(target_ns) and self.odom_pub is not None:
             self._publish_odom(stamp)
         if streams["ground_truth"].due(target_ns):
             self._publish_truth(stamp)
@@ -350,6 +380,7 @@ class Simulator(Node):
     def _publish_odom(self, stamp: Any) -> None:
         body = self.body
         var = max(self.odom_noise_std, 1e-3) ** 2
+        assert self.odom_pub is not None
         self.odom_pub.publish(
             odometry_message(stamp, FRAMES["odom"], FRAMES["base"], body.odom_pose, body.odom_twist,
                              (var * (1 + body.distance_m),) * 3, (var, var, var))
@@ -359,6 +390,7 @@ class Simulator(Node):
         joints.name = list(self.kinematics.wheel_names)
         joints.position = body.wheel_positions.copy()
         joints.velocity = body.wheel_velocities.copy()
+        assert self.joint_pub is not None
         self.joint_pub.publish(joints)
         if self._tf is not None:
             t = static_transform(FRAMES["odom"], FRAMES["base"], (body.odom_pose[0], body.odom_pose[1], 0.0),
