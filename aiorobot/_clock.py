@@ -291,6 +291,16 @@ class Clock:
                 return
             heapq.heappush(self._waiters, (deadline_ns, next(self._seq), loop, fut))
 
+    def next_deadline_ns(self) -> int | None:
+        """The earliest sim-time deadline anyone waits for (a timer, a rate, a timeout), or None.
+
+        A simulator that owns time steps to it so every timer fires exactly on its deadline.
+        """
+        with self._lock:
+            while self._waiters and self._waiters[0][3].done():
+                heapq.heappop(self._waiters)
+            return self._waiters[0][0] if self._waiters else None
+
     async def sleep_until_ns(self, deadline_ns: int) -> None:
         """Wait until sim time reads ``deadline_ns``; raises :class:`ClockJump` on a backwards jump."""
         fut: asyncio.Future[None] = asyncio.get_running_loop().create_future()

@@ -25,6 +25,7 @@ PARTS: dict[str, str] = {
     "tf": "aiorobot.bench.tf",
     "bag": "aiorobot.bench._bag",
     "nav": "aiorobot.bench._nav",
+    "sim": "aiorobot.bench._sim",
 }
 
 
