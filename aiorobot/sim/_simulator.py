@@ -263,6 +263,15 @@ class Simulator(Node):
             self.pty.close_pty()
 
     async def _run(self) -> None:
+        try:
+            await self._loop_steps()
+        except asyncio.CancelledError:
+            raise
+        except Exception:
+            self.get_logger().error(f"the simulation loop stopped at t={self.time_ns / _NS:.3f} s", exc_info=True)
+            self.runtime.shutdown()
+
+    async def _loop_steps(self) -> None:
         from aiorobot.testing import settle
 
         runtime = self.runtime
@@ -290,8 +299,7 @@ class Simulator(Node):
                 target = end_ns
             if not lockstep:
                 delay = wall_start + target / _NS / self.real_time_factor - loop.time()
-                if delay > 0:
-                    await asyncio.sleep(delay)
+                await asyncio.sleep(max(delay, 0.0))  # behind schedule: still let other tasks run
             self.step_to(target)
             if lockstep:
                 await settle(runtime)
