@@ -334,8 +334,8 @@ class Simulator(Node):
         if self.pty is not None and self.pty.is_open:
             self.pty.pump()  # the firmware integrates its motors to the new sim time and reports ticks
         self.steps += 1
-        self._publish_clock()
         stamp = self._stamp()
+        self._publish_clock(stamp)
         streams = self._streams
         if streams["imu"].due(target_ns):
             self._publish_imu(stamp, streams["imu"].period_ns / _NS)
@@ -355,9 +355,9 @@ class Simulator(Node):
 
         return Time(nanoseconds=self.time_ns).to_msg()
 
-    def _publish_clock(self) -> None:
+    def _publish_clock(self, stamp: Any = None) -> None:
         msg = self._types["clock"]()
-        msg.clock = self._stamp()
+        msg.clock = self._stamp() if stamp is None else stamp
         self.clock_pub.publish(msg)
 
     def _publish_static(self, stamp: Any) -> None:
