@@ -263,6 +263,15 @@ class Simulator(Node):
             self.pty.close_pty()
 
     async def _run(self) -> None:
+        try:
+            await self._loop_steps()
+        except asyncio.CancelledError:
+            raise
+        except Exception:
+            self.get_logger().error(f"the simulation loop stopped at t={self.time_ns / _NS:.3f} s", exc_info=True)
+            self.runtime.shutdown()
+
+    async def _loop_steps(self) -> None:
         from aiorobot.testing import settle
 
         runtime = self.runtime
@@ -290,8 +299,7 @@ class Simulator(Node):
                 target = end_ns
             if not lockstep:
                 delay = wall_start + target / _NS / self.real_time_factor - loop.time()
-                if delay > 0:
-                    await asyncio.sleep(delay)
+                await asyncio.sleep(max(delay, 0.0))  # behind schedule: still let other tasks run
             self.step_to(target)
             if lockstep:
                 await settle(runtime)
@@ -326,8 +334,8 @@ class Simulator(Node):
         if self.pty is not None and self.pty.is_open:
             self.pty.pump()  # the firmware integrates its motors to the new sim time and reports ticks
         self.steps += 1
-        self._publish_clock()
         stamp = self._stamp()
+        self._publish_clock(stamp)
         streams = self._streams
         if streams["imu"].due(target_ns):
             self._publish_imu(stamp, streams["imu"].period_ns / _NS)
@@ -347,9 +355,9 @@ class Simulator(Node):
 
         return Time(nanoseconds=self.time_ns).to_msg()
 
-    def _publish_clock(self) -> None:
+    def _publish_clock(self, stamp: Any = None) -> None:
         msg = self._types["clock"]()
-        msg.clock = self._stamp()
+        msg.clock = self._stamp() if stamp is None else stamp
         self.clock_pub.publish(msg)
 
     def _publish_static(self, stamp: Any) -> None:
