@@ -23,6 +23,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "foxglove": ("aiorobot.cli._foxglove", "serve the graph live to the Foxglove app (WebSocket)"),
     "plot": ("aiorobot.cli._plot", "plot message fields over time from a bag or the live graph"),
     "map": ("aiorobot.cli._map", "save the published map as map_server YAML + PGM"),
+    "demo": ("aiorobot.cli._demo", "the simulated robot navigating a waypoint mission, with a summary"),
     "sim": ("aiorobot.cli._sim", "run the simulated robot in a world (lidar, IMU, odometry, camera)"),
 }
 

@@ -57,6 +57,7 @@ class NavigationServer(Node):
         self.frequency = float(d("controller_frequency", 20.0).value)
         self.replan_period = float(d("replan_period", 1.0).value)
         self.map_timeout = float(d("map_timeout", 10.0).value)
+        self.transform_timeout = float(d("transform_timeout", 10.0).value)
         self.max_recoveries = int(d("max_recoveries", 6).value)
         self.required_movement_radius = float(d("required_movement_radius", 0.5).value)
         self.movement_time_allowance = float(d("movement_time_allowance", 10.0).value)
@@ -238,6 +239,19 @@ class NavigationServer(Node):
             await clock.sleep_for(0.1)
             waited += 0.1
 
+    async def _wait_for_robot_pose(self) -> None:
+        """Wait (up to ``transform_timeout`` on the node's clock) for global_frame -> robot_base_frame,
+        as Nav2 waits for localisation before it drives."""
+        from aiorobot import Time
+
+        clock = self.get_clock()
+        waited = 0.0
+        while not self.buffer.can_transform(self.global_frame, self.base_frame, Time()):
+            if waited >= self.transform_timeout:
+                self._robot_pose()  # raises the TF_ERROR abort with tf's reason
+            await clock.sleep_for(0.05)
+            waited += 0.05
+
     def _robot_pose(self) -> tuple[float, float, float]:
         from aiorobot import Time
         from aiorobot.tf import TransformException
@@ -274,6 +288,7 @@ class NavigationServer(Node):
         from aiorobot import Duration
 
         await self._wait_for_map()
+        await self._wait_for_robot_pose()
         goal = xyyaw(target)
         rpp = RegulatedPurePursuit(self.rpp_params, self.costmap)
         clock = self.get_clock()

@@ -1,0 +1,12 @@
+"""``aiorobot demo``: the simulated mecanum robot following a waypoint mission.
+
+The simulator's world and robot, AMCL localisation on the world's map, the navigation server
+(costmap, A*, Regulated Pure Pursuit, recoveries) and the asyncio BasicNavigator, in one runtime
+on sim time; a live progress line, a summary against ground truth, ``--json`` and ``--plot``.
+"""
+
+from __future__ import annotations
+
+from ._mission import MISSIONS, DemoSummary, parse_waypoints, run_demo
+
+__all__ = ["MISSIONS", "DemoSummary", "parse_waypoints", "run_demo"]

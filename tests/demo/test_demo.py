@@ -1,0 +1,51 @@
+"""The whole robot on sim time: simulator + AMCL + navigation server + BasicNavigator (issue 15's end-to-end test)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from aiorobot.cli import main
+from aiorobot.demo import parse_waypoints, run_demo
+
+pytestmark = pytest.mark.timeout(300)
+
+
+async def test_a_short_mission_in_the_box_reaches_every_waypoint_without_collision() -> None:
+    summary = await run_demo("box", [(1.5, 0.0, math.pi / 2), (1.5, 1.5, math.pi)], seed=3, timeout_sim_sec=120.0)
+    assert summary.waypoints_reached == 2 and summary.collisions == 0, summary.figures()
+    assert summary.succeeded
+    assert summary.localisation_rmse_m < 0.15  # AMCL against ground truth (the shipped mission's target is 5 cm)
+    assert summary.path_length_m > 2.5
+    assert summary.sim_sec < 120.0
+
+
+def test_waypoints_parse_and_bad_ones_are_named() -> None:
+    assert parse_waypoints("1,2;3,4,1.5") == [(1.0, 2.0, 0.0), (3.0, 4.0, 1.5)]
+    with pytest.raises(ValueError, match=r"waypoint 2: expected x,y or x,y,yaw numbers, found '3,a'"):
+        parse_waypoints("1,2;3,a")
+    with pytest.raises(ValueError, match="at least one waypoint"):
+        parse_waypoints(" ; ")
+
+
+def test_cli_refuses_a_waypoint_in_a_wall_before_starting(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo", "--world", "box", "--waypoints", "3.0,0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "waypoint 1 (3, 0) is outside the map or inside an obstacle of box" in err
+    assert main(["demo", "--world", "nowhere"]) == 2
+    assert "nowhere" in capsys.readouterr().err
+
+
+def test_cli_writes_the_summary_json_and_a_plot(tmp_path: Path) -> None:
+    out, png = tmp_path / "summary.json", tmp_path / "demo.png"
+    status = main(["demo", "--world", "box", "--waypoints", "1.0,0,0", "--seed", "2", "--json", str(out), "--plot", str(png)])
+    figures = json.loads(out.read_text())
+    assert status == 0, figures
+    for key in ("waypoints_reached", "waypoints_total", "collisions", "localisation_rmse_m", "control_period_p99_ms",
+                "control_period_max_ms", "perception_fps", "sim_sec", "wall_sec"):
+        assert key in figures
+    assert figures["waypoints_reached"] == figures["waypoints_total"] == 1
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
