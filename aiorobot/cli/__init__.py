@@ -19,6 +19,11 @@ __all__ = ["COMMANDS", "main"]
 COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config (default: the bundled example)"),
     "bench": ("aiorobot.bench._cli", "executor and transport latency benchmark"),
+    "router": ("aiorobot.cli._router", "a zenoh router joining graphs across processes and machines (rmw_zenohd)"),
+    "topic": ("aiorobot.cli._topic", "topics of the running graph: list, info, echo, pub, hz, bw"),
+    "node": ("aiorobot.cli._node_cmd", "nodes of the running graph: list, info"),
+    "service": ("aiorobot.cli._service", "services of the running graph: list, call"),
+    "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
 }
 
 
