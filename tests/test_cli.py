@@ -92,10 +92,12 @@ def test_duration_that_is_not_a_number_exits_2_with_one_line() -> None:
             "aiorobot: error: unrecognized arguments: b.toml (see 'aiorobot --help')",
         ),
         (["run", "--fast"], "aiorobot: error: unrecognized arguments: --fast (see 'aiorobot --help')"),
-        ([], "aiorobot: error: expected a command (run, bench), found none (see 'aiorobot --help')"),
+        ([], f"aiorobot: error: expected a command ({', '.join(COMMANDS)}), found none (see 'aiorobot --help')"),
         (
             ["fly"],
-            "aiorobot: error: argument COMMAND: invalid choice: 'fly' (choose from 'run', 'bench') "
+            "aiorobot: error: argument COMMAND: invalid choice: 'fly' (choose from "
+            + ", ".join(repr(c) for c in COMMANDS)
+            + ") "
             "(see 'aiorobot --help')",
         ),
     ],
