@@ -23,6 +23,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "topic": ("aiorobot.cli._topic", "topics of the running graph: list, info, echo, pub, hz, bw"),
     "node": ("aiorobot.cli._node_cmd", "nodes of the running graph: list, info"),
     "service": ("aiorobot.cli._service", "services of the running graph: list, call"),
+    "action": ("aiorobot.cli._action", "actions of the running graph: list, info, send_goal"),
     "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
 }
 

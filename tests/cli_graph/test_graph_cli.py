@@ -12,9 +12,17 @@ from tests.transport._helpers import free_port, open_router, spawn
 GRAPH = """
 from aiorobot.msgs.std_msgs import String
 from aiorobot.msgs.geometry_msgs import Twist
-from aiorobot.msgs.example_interfaces import AddTwoInts
+from aiorobot.msgs.example_interfaces import AddTwoInts, Fibonacci
+async def fib(handle):
+    seq = [0, 1]
+    for _ in range(handle.request.order - 1):
+        seq.append(seq[-1] + seq[-2])
+        handle.publish_feedback(Fibonacci.Feedback(sequence=list(seq)))
+    handle.succeed()
+    return Fibonacci.Result(sequence=seq)
 async def main(rt):
     node = rt.add_node(Node("talker", namespace="/robot"))
+    node.create_action_server(Fibonacci, "/fib", fib)
     pub = node.create_publisher(String, "/chatter", 10)
     node.create_subscription(Twist, "/cmd_vel", lambda m: say("cmd_vel", m.linear.x), 10)
     node.create_service(AddTwoInts, "/add", lambda r: AddTwoInts.Response(sum=r.a + r.b))
@@ -78,6 +86,14 @@ async def test_topic_node_service_and_graph_commands_see_the_other_process(graph
     code, out, err = await cli(port, "topic", "pub", "/cmd_vel", "geometry_msgs/msg/Twist", "{linear: {x: 0.5}}", "--once")
     assert code == 0, err
     assert (await child.expect("cmd_vel")) == "cmd_vel 0.5"
+
+    code, out, err = await cli(port, "action", "list", "-t")
+    assert code == 0, err
+    assert out.splitlines() == ["/fib [example_interfaces/action/Fibonacci]"]
+
+    code, out, err = await cli(port, "action", "send_goal", "/fib", "example_interfaces/action/Fibonacci", "{order: 5}")
+    assert code == 0, err
+    assert "Result:\nsequence:\n- 0\n- 1\n- 1\n- 2\n- 3\n- 5\n" in out and "status: SUCCEEDED" in out
 
     code, out, err = await cli(port, "graph", "--dot")
     assert code == 0, err
