@@ -26,7 +26,7 @@ from aiorobot.msgs.geometry_msgs import Twist
 from aiorobot.msgs.sensor_msgs import Image
 
 async def main(port):
-    lat = {"twist": [], "image": []}
+    lat = {"twist": [], "image": [], "raw": []}
     burst = {"n": 0, "first": 0, "last": 0}
     async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
         node = rt.add_node(Node("bench_sink"))
@@ -43,6 +43,8 @@ async def main(port):
         keep_all = QoSProfile(history=HistoryPolicy.KEEP_ALL)
         node.create_subscription(Twist, "/bench/twist", on_twist, keep_all)
         node.create_subscription(Image, "/bench/image", on_image, keep_all)
+        raw = rt.transport._session.declare_subscriber(
+            "bench/raw", lambda s: lat["raw"].append(time.monotonic_ns() - int.from_bytes(s.payload.to_bytes()[:8], "little")))
         print("ready", flush=True)
         loop = asyncio.get_running_loop()
         reader = asyncio.StreamReader()
@@ -50,7 +52,7 @@ async def main(port):
         while line := (await reader.readline()).decode().strip():
             if line == "report":
                 print(json.dumps({"lat": lat, "burst": burst}), flush=True)
-                lat = {"twist": [], "image": []}
+                lat = {"twist": [], "image": [], "raw": []}
                 burst.update(n=0, first=0, last=0)
 
 aiorobot.run(main(int(sys.argv[1])))
@@ -120,8 +122,11 @@ async def _measure(port: int, child: subprocess.Popen[str], quick: bool) -> dict
             twist.publish(Twist(linear=Vector3(x=float(time.monotonic_ns()))))
             await asyncio.sleep(0.001)
         await _report(child)
+        raw = rt.transport._session.declare_publisher("bench/raw")  # type: ignore[attr-defined]
         for _ in range(n_lat):
             twist.publish(Twist(linear=Vector3(x=float(time.monotonic_ns()))))
+            await asyncio.sleep(0.0005)
+            raw.put(time.monotonic_ns().to_bytes(8, "little") + bytes(44))  # same size as a Twist's CDR
             await asyncio.sleep(0.0005)
         data = np.zeros(640 * 480 * 3, dtype=np.uint8)
         for _ in range(n_img):
@@ -141,6 +146,7 @@ async def _measure(port: int, child: subprocess.Popen[str], quick: bool) -> dict
     recv_sec = max((burst["last"] - burst["first"]) / 1e9, 1e-9)
     return {
         "twist": _stats(lat["twist"]),
+        "raw_zenoh": _stats(lat["raw"]),
         "image_copy": _stats(lat["image"]),
         "image_shm": {"note": "not measured: the shared-memory path is not implemented yet"},
         "burst": {"sent": n_burst, "received": burst["n"], "send_msgs_per_sec": n_burst / send_sec,
@@ -162,7 +168,9 @@ def table(part: dict[str, Any]) -> Any:
     if "error" in part:
         return figure_table("zenoh transport (two processes, loopback)", ("path", "note"), [("zenoh", part["error"])])
     t, img, b = part["twist"], part["image_copy"], part["burst"]
+    raw = part.get("raw_zenoh", {})
     rows = [
+        ("bare zenoh-python put -> callback (baseline)", raw.get("p50_us", float("nan")), raw.get("p99_us", float("nan")), float("nan")),
         ("Twist one-way", t.get("p50_us", float("nan")), t.get("p99_us", float("nan")), float(b["recv_msgs_per_sec"])),
         ("Image 640x480x3 one-way (copy)", img.get("p50_us", float("nan")), img.get("p99_us", float("nan")), float("nan")),
     ]
