@@ -210,10 +210,16 @@ class Bus:
     def snapshot(self) -> list[_Topic]:
         """A consistent copy of every topic's endpoints (for ``Runtime.graph``)."""
         with self._lock:
-            return [
-                _Topic(t.name, list(t.publishers), list(t.subscriptions), list(t.incompatible))
+            topics = [
+                _Topic(
+                    t.name,
+                    [p for p in t.publishers if not _hidden(p)],
+                    [s for s in t.subscriptions if not _hidden(s)],
+                    [(p, s, r) for p, s, r in t.incompatible if not (_hidden(p) or _hidden(s))],
+                )
                 for t in sorted(self._topics.values(), key=lambda t: t.name)
             ]
+        return [t for t in topics if t.publishers or t.subscriptions]
 
     def incompatibilities(self) -> list[Incompatibility]:
         with self._lock:
@@ -221,4 +227,10 @@ class Bus:
                 Incompatibility(t.name, p.describe(), s.describe(), r, p.node_name, s.node_name)
                 for t in self._topics.values()
                 for p, s, r in t.incompatible
+                if not (_hidden(p) or _hidden(s))
             ]
+
+
+def _hidden(endpoint: Endpoint) -> bool:
+    """A transport's internal endpoint (its sender tap, its catch-all injector): not part of the graph."""
+    return getattr(endpoint, "hidden", False)

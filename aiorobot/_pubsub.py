@@ -87,7 +87,7 @@ class Publisher(Endpoint, Generic[M]):
 
     def get_subscription_count(self) -> int:
         """How many subscriptions (in this process and, with a transport, remote) receive this publisher."""
-        return len(self._subs)
+        return sum(1 for s in self._subs if not getattr(s, "hidden", False))
 
     def _set_targets(self, subs: tuple[Subscription | Tap, ...]) -> None:
         """Install the matched subscriptions (called by the bus under its lock)."""

@@ -249,6 +249,7 @@ class Runtime:
             assert self._loop is not None and self._thread_id is not None and self._waker is not None
             node._bind(self, executor, self._loop, self._thread_id, self._waker)
         added: list[Any] = []
+        self.transport.node_added(node)
         try:
             for pub in node._publishers:
                 self._bus.add_publisher(pub)
@@ -259,6 +260,7 @@ class Runtime:
         except BaseException:
             for endpoint in added:
                 self._bus.remove(endpoint)
+            self.transport.node_removed(node)
             node._unbind()
             raise
         for service in node._services:
@@ -309,6 +311,7 @@ class Runtime:
             self._bus.services.remove(service)
         for client in node._clients:
             self._bus.services.remove(client)
+        self.transport.node_removed(node)
         loop = node._loop
         if loop is not None and not loop.is_closed():
             if loop is self._loop:
@@ -543,7 +546,7 @@ class Runtime:
         nodes = tuple(
             NodeInfo(n.get_name(), n.get_namespace(), n.get_fully_qualified_name(), n.executor or "")
             for n in self._nodes
-        )
+        ) + tuple(self.transport.remote_nodes())
         topics = []
         for t in self._bus.snapshot():
             def info(e: Any, kind: str, topic: str = t.name) -> EndpointInfo:

@@ -350,11 +350,13 @@ class ServiceRegistry:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._entries: dict[str, _Entry] = {}
+        #: A transport told of every server and client added or removed (set by the transport).
+        self.listener: Any = None
 
     def add(self, endpoint: Service | Client) -> None:
         with self._lock:
             entry = self._entries.setdefault(endpoint.srv_name, _Entry())
-            if isinstance(endpoint, Service):
+            if endpoint.kind == "service":  # a local Service or a transport's remote server
                 entry.servers.append(endpoint)
                 ready = [fut for t, fut in entry.waiters if t == endpoint.type_name]
                 entry.waiters = [(t, f) for t, f in entry.waiters if t != endpoint.type_name]
@@ -363,6 +365,8 @@ class ServiceRegistry:
                 ready = []
         for fut in ready:
             _call_on(fut.get_loop(), _resolve, fut)
+        if self.listener is not None:
+            self.listener.endpoint_added(endpoint)
 
     def remove(self, endpoint: Service | Client) -> None:
         with self._lock:
@@ -374,6 +378,8 @@ class ServiceRegistry:
                     group.remove(endpoint)  # type: ignore[arg-type]
             if not entry.servers and not entry.clients and not entry.waiters:
                 del self._entries[endpoint.srv_name]
+        if self.listener is not None:
+            self.listener.endpoint_removed(endpoint)
 
     def servers(self, name: str, type_name: str | None = None) -> list[Service]:
         with self._lock:

@@ -17,10 +17,13 @@ plugs in without changing it.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import os
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from ._bus import Bus, Endpoint
+    from ._graph import NodeInfo
+    from ._node import Node
 
 __all__ = ["LocalTransport", "Transport", "make_transport"]
 
@@ -48,6 +51,16 @@ class Transport:
     def endpoint_removed(self, endpoint: Endpoint) -> None:
         """A local endpoint went away (any thread)."""
 
+    def node_added(self, node: Node) -> None:
+        """A local node joined (before its endpoints are added)."""
+
+    def node_removed(self, node: Node) -> None:
+        """A local node left (after its endpoints were removed)."""
+
+    def remote_nodes(self) -> tuple[NodeInfo, ...]:
+        """Nodes in other processes that this transport has discovered."""
+        return ()
+
     def __repr__(self) -> str:
         return f"<{type(self).__name__} domain_id={self.domain_id}>"
 
@@ -58,11 +71,21 @@ class LocalTransport(Transport):
     name = "local"
 
 
-def make_transport(name: str, *, domain_id: int = 0) -> Transport:
+def make_transport(name: str, *, domain_id: int = 0, **options: Any) -> Transport:
+    """``"local"`` or ``"zenoh"``; ``options`` go to the zenoh transport (``config_file``, ``connect``, ``listen``).
+
+    For zenoh, ``ROS_DOMAIN_ID`` in the environment applies when ``domain_id`` is left at 0,
+    as in ROS 2.
+    """
     if name == "local":
         return LocalTransport(domain_id=domain_id)
     if name == "zenoh":
-        raise NotImplementedError(
-            "transport 'zenoh' is not available in this version of aiorobot yet; use transport='local'"
-        )
+        from .transport import ZenohTransport
+
+        if domain_id == 0 and os.environ.get("ROS_DOMAIN_ID", "").strip():
+            raw = os.environ["ROS_DOMAIN_ID"].strip()
+            if not raw.isdigit() or not 0 <= int(raw) <= 232:
+                raise ValueError(f"ROS_DOMAIN_ID: expected an int in 0..232, found {raw!r}")
+            domain_id = int(raw)
+        return ZenohTransport(domain_id=domain_id, **options)
     raise ValueError(f"transport: expected 'local' or 'zenoh', found {name!r}")

@@ -26,6 +26,7 @@ PARTS: dict[str, str] = {
     "bag": "aiorobot.bench._bag",
     "nav": "aiorobot.bench._nav",
     "sim": "aiorobot.bench._sim",
+    "zenoh": "aiorobot.bench._zenoh",
 }
 
 

@@ -25,6 +25,12 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "map": ("aiorobot.cli._map", "save the published map as map_server YAML + PGM"),
     "demo": ("aiorobot.cli._demo", "the simulated robot navigating a waypoint mission, with a summary"),
     "sim": ("aiorobot.cli._sim", "run the simulated robot in a world (lidar, IMU, odometry, camera)"),
+    "router": ("aiorobot.cli._router", "a zenoh router joining graphs across processes and machines (rmw_zenohd)"),
+    "topic": ("aiorobot.cli._topic", "topics of the running graph: list, info, echo, pub, hz, bw"),
+    "node": ("aiorobot.cli._node_cmd", "nodes of the running graph: list, info"),
+    "service": ("aiorobot.cli._service", "services of the running graph: list, call"),
+    "action": ("aiorobot.cli._action", "actions of the running graph: list, info, send_goal"),
+    "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
 }
 
 

@@ -1,0 +1,128 @@
+"""What the graph commands share: joining the graph over zenoh, and messages as YAML."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import os
+import time
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from typing import Any
+
+import numpy as np
+
+__all__ = ["UserError", "add_graph_options", "fill_message", "join_graph", "message_to_yaml", "to_plain"]
+
+#: Discovery is complete once no liveliness token has arrived for this long.
+QUIET_SEC = 0.15
+DISCOVERY_MAX_SEC = 2.0
+
+
+class UserError(Exception):
+    """Bad input from the command line: printed as one line, exit status 1."""
+
+
+def add_graph_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--connect", action="append", metavar="ENDPOINT",
+        help="zenoh endpoint of a router or peer (default tcp/127.0.0.1:7447, as rmw_zenoh)",
+    )
+    parser.add_argument("--domain-id", type=int, default=None, help="ROS domain id (default: ROS_DOMAIN_ID or 0)")
+
+
+@asynccontextmanager
+async def join_graph(args: argparse.Namespace) -> AsyncIterator[Any]:
+    """A runtime on the zenoh transport that has seen the graph's current tokens."""
+    from .. import Runtime
+    from ..transport import ZenohTransport
+
+    domain = args.domain_id if args.domain_id is not None else int(os.environ.get("ROS_DOMAIN_ID", "0") or 0)
+    transport = ZenohTransport(domain_id=domain, connect=args.connect)
+    async with Runtime(transport=transport, domain_id=domain, handle_signals=False) as rt:
+        await settle_discovery(transport)
+        yield rt
+
+
+async def settle_discovery(transport: Any) -> None:
+    start = last_change = time.monotonic()
+    seen = len(transport._remote)
+    while time.monotonic() - start < DISCOVERY_MAX_SEC:
+        await asyncio.sleep(0.02)
+        now_seen = len(transport._remote)
+        if now_seen != seen:
+            seen, last_change = now_seen, time.monotonic()
+        elif time.monotonic() - last_change >= QUIET_SEC:
+            return
+
+
+def to_plain(msg: Any) -> Any:
+    """A message as plain Python data (dicts, lists, numbers, strings) in field order."""
+    if hasattr(msg, "get_fields_and_field_types"):
+        return {name: to_plain(getattr(msg, name)) for name in msg.get_fields_and_field_types()}
+    if isinstance(msg, np.ndarray):
+        return [to_plain(v) for v in msg.tolist()]
+    if isinstance(msg, (list, tuple)):
+        return [to_plain(v) for v in msg]
+    if isinstance(msg, np.generic):
+        return msg.item()
+    if isinstance(msg, bytes):
+        return list(msg)
+    return msg
+
+
+def message_to_yaml(msg: Any) -> str:
+    """ros2cli's echo format: block YAML of the fields, in order."""
+    import yaml
+
+    return yaml.safe_dump(to_plain(msg), sort_keys=False, default_flow_style=False, allow_unicode=True)
+
+
+def fill_message(msg_type: Any, text: str) -> Any:
+    """A ``msg_type`` instance from YAML text (``"{linear: {x: 0.5}}"``), naming the field at fault."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(text) if text.strip() else {}
+    except yaml.YAMLError as err:
+        raise UserError(f"values: expected YAML such as '{{linear: {{x: 0.5}}}}', found {text!r} ({err})") from None
+    if data is None:
+        data = {}
+    return _fill(msg_type, data, msg_type.__msgtype__)
+
+
+def _fill(msg_type: Any, data: Any, where: str) -> Any:
+    if not isinstance(data, dict):
+        raise UserError(f"{where}: expected a mapping of fields for {msg_type.__msgtype__}, found {data!r}")
+    fields = msg_type.get_fields_and_field_types()
+    msg = msg_type()
+    for key, value in data.items():
+        if key not in fields:
+            raise UserError(
+                f"{where}.{key}: {msg_type.__msgtype__} has no field {key!r}; its fields are {', '.join(fields)}"
+            )
+        current = getattr(msg, key)
+        if hasattr(current, "get_fields_and_field_types"):
+            value = _fill(type(current), value, f"{where}.{key}")
+        elif isinstance(current, list) and isinstance(value, list) and fields[key].startswith(("sequence<", "")) and value and isinstance(value[0], dict):
+            from ..msgs import get
+
+            inner = fields[key].split("<", 1)[-1].rstrip(">").split(",")[0].strip()
+            try:
+                cls = get(inner)
+                value = [_fill(cls, v, f"{where}.{key}[{i}]") for i, v in enumerate(value)]
+            except UserError:
+                raise
+            except Exception:
+                pass
+        try:
+            setattr(msg, key, value)
+        except (TypeError, ValueError) as err:
+            raise UserError(f"{where}.{key}: expected {fields[key]}, found {value!r} ({err})") from None
+    from ..msgs import SerializationError, serialize
+
+    try:
+        serialize(msg)
+    except SerializationError as err:
+        raise UserError(f"{where}: {err}") from None
+    return msg

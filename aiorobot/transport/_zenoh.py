@@ -1,0 +1,844 @@
+"""The zenoh transport: a runtime's bus extended to other processes and machines, rmw_zenoh's way.
+
+* A local publisher gets an rmw_zenoh liveliness token; its topic gets one zenoh
+  publisher fed by a hidden *sender tap* on the bus, which serialises to CDR in the
+  publishing thread and puts with the 33-byte attachment. Same-process subscribers
+  keep zero-copy delivery: they never see the tap.
+* A local subscription gets a token; its topic gets one zenoh subscriber (an
+  advanced one with history for transient local). Samples are checked (key, type
+  hash, attachment, CDR) and deserialised on zenoh's thread, then handed to the
+  main loop with ``call_soon_threadsafe``, where an *injector* (a publisher standing
+  for the remote one) publishes them into the bus.
+* Remote endpoints learnt from liveliness tokens join the bus as endpoints of their
+  own (injectors for publishers, passive taps for subscriptions, remote servers and
+  clients for services), so ``Runtime.graph``, ``count_subscribers``,
+  ``wait_for_service`` and the QoS-incompatibility warnings see them exactly as
+  local ones.
+* Services are queryables declared ``complete=True``; calls are queries.
+
+Malformed input from the network is dropped with a throttled warning and counted
+in :meth:`ZenohTransport.statistics`; it never reaches user code.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import logging
+import os
+import threading
+import time
+from collections import Counter
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from .._pubsub import Publisher, Subscription, Tap
+from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from .._services import Client, Service, _Call, _reply
+from .._errors import ServiceError
+from .._transport import Transport
+from ._wire import (
+    WireError,
+    data_key,
+    dds_type,
+    endpoint_token,
+    gid_of,
+    node_token,
+    pack_attachment,
+    parse_token,
+    unpack_attachment,
+)
+
+if TYPE_CHECKING:
+    from .._bus import Bus
+    from .._graph import NodeInfo
+    from .._node import Node
+
+__all__ = ["TransportStatistics", "ZenohTransport"]
+
+_log = logging.getLogger("aiorobot.transport")
+
+DEFAULT_CONNECT = "tcp/127.0.0.1:7447"
+DEFAULT_LISTEN = "tcp/127.0.0.1:0"
+#: A service query waits this long at most on the zenoh side (callers time out on their own).
+QUERY_TIMEOUT_SEC = 24 * 3600.0
+WARN_INTERVAL_SEC = 1.0
+_ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
+_FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
+
+
+@dataclass(frozen=True, slots=True)
+class TransportStatistics:
+    """What a zenoh transport has sent, received and dropped."""
+
+    sent: int
+    received: int
+    dropped: int
+    drop_reasons: dict[str, int]
+    remote_nodes: int
+
+
+class _Owner:
+    """The stand-in node of endpoints the transport adds to the bus (they run on the main loop)."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop, thread_id: int, name: str) -> None:
+        self._loop = loop
+        self._thread_id = thread_id
+        self._name = name
+
+    def get_fully_qualified_name(self) -> str:
+        return self._name
+
+    def _call_soon(self, fn: Any, *args: Any) -> None:
+        fn(*args)
+
+    def get_logger(self) -> logging.Logger:
+        return _log
+
+
+class _Injector(Publisher):  # type: ignore[type-arg]
+    """Publishes into the bus what a remote publisher sent; its node name is the remote node's."""
+
+    def __init__(self, owner: _Owner, msg_type: Any, topic: str, qos: QoSProfile, remote: str, *, hidden: bool = False) -> None:
+        super().__init__(owner, msg_type, topic, qos)  # type: ignore[arg-type]
+        self.remote = remote
+        self.hidden = hidden
+        if hidden:
+            self._history = None
+
+    @property
+    def node_name(self) -> str:
+        return self.remote
+
+    def __repr__(self) -> str:
+        return f"<remote publisher {self.topic_name} {self.type_name} of {self.remote}>"
+
+
+class _RemoteServer:
+    """A service server in another process, as the local registry sees it."""
+
+    kind = "service"
+
+    def __init__(self, transport: ZenohTransport, srv_type: Any, name: str, key: str, node_name: str) -> None:
+        self.transport = transport
+        self.node = transport._owner
+        self.srv_type = srv_type
+        self.srv_name = name
+        self.key = key
+        self.remote = node_name
+        self.destroyed = False
+
+    @property
+    def type_name(self) -> str:
+        return str(self.srv_type.__msgtype__)
+
+    @property
+    def node_name(self) -> str:
+        return self.remote
+
+    def is_idle(self) -> bool:
+        return True
+
+    def __repr__(self) -> str:
+        return f"<remote service {self.srv_name} {self.type_name} of {self.remote}>"
+
+    def _enqueue(self, call: _Call) -> None:
+        self.transport._query(self, call)
+
+
+class _RemoteClient:
+    kind = "client"
+
+    def __init__(self, type_name: str, name: str, node_name: str) -> None:
+        self._type_name = type_name
+        self.srv_name = name
+        self.remote = node_name
+        self.destroyed = False
+
+    @property
+    def type_name(self) -> str:
+        return self._type_name
+
+    @property
+    def node_name(self) -> str:
+        return self.remote
+
+
+@dataclass
+class _LocalNode:
+    nid: int
+    token: Any
+    endpoints: int = 0
+
+
+class _Outbound:
+    """One topic's zenoh publisher, fed by a hidden tap on the bus."""
+
+    def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
+        self.transport = transport
+        self.topic = topic
+        self.msg_type = msg_type
+        self.key = data_key(transport.domain_id, topic, msg_type.__msgtype__, type_hash)
+        self.publishers: list[Publisher[Any]] = []
+        self.gid = b"\0" * 16
+        self.seq = 0
+        self.zpub: Any = None
+        self.advanced = False
+        self.depth = 0
+        self.lock = threading.Lock()
+        self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>")
+        self.tap.hidden = True  # type: ignore[attr-defined]
+
+    def declare(self, qos: QoSProfile) -> None:
+        """(Re)declare the zenoh publisher so it serves ``qos`` (a cache for transient local)."""
+        import zenoh
+        import zenoh.ext
+
+        session = self.transport._session
+        want_cache = qos.durability is DurabilityPolicy.TRANSIENT_LOCAL
+        depth = qos.depth if qos.history is HistoryPolicy.KEEP_LAST else 1000
+        if self.zpub is not None and (self.advanced or not want_cache) and depth <= self.depth:
+            return
+        reliable = qos.reliability is ReliabilityPolicy.RELIABLE
+        kwargs: dict[str, Any] = dict(
+            reliability=zenoh.Reliability.RELIABLE if reliable else zenoh.Reliability.BEST_EFFORT,
+            congestion_control=(
+                zenoh.CongestionControl.BLOCK
+                if reliable and qos.history is HistoryPolicy.KEEP_ALL
+                else zenoh.CongestionControl.DROP
+            ),
+            allowed_destination=zenoh.Locality.REMOTE,
+        )
+        old = self.zpub
+        if want_cache or self.advanced:
+            self.depth = max(depth, self.depth)
+            self.zpub = zenoh.ext.declare_advanced_publisher(
+                session,
+                self.key,
+                cache=zenoh.ext.CacheConfig(max_samples=self.depth),
+                publisher_detection=True,
+                sample_miss_detection=(
+                    zenoh.ext.MissDetectionConfig(heartbeat=None, sporadic_heartbeat=0.5) if reliable else None
+                ),
+                **kwargs,
+            )
+            self.advanced = True
+        else:
+            self.depth = max(depth, self.depth)
+            self.zpub = session.declare_publisher(self.key, **kwargs)
+        if old is not None:
+            old.undeclare()
+
+    def _send(self, msg: Any) -> None:
+        """The tap's callback: runs in the publishing thread."""
+        transport = self.transport
+        if getattr(transport._local, "injecting", False):
+            return  # it came from the network: do not echo it back
+        from ..msgs import serialize
+
+        try:
+            data = serialize(msg)
+        except (TypeError, ValueError) as err:
+            transport._warn("serialize", f"cannot send a message on {self.topic}: {err}")
+            return
+        with self.lock:
+            self.seq += 1
+            attachment = pack_attachment(self.seq, time.time_ns(), self.gid)
+            zpub = self.zpub
+        if zpub is not None:
+            zpub.put(data, attachment=attachment)
+            transport._sent += 1
+
+    def close(self) -> None:
+        if self.zpub is not None:
+            self.zpub.undeclare()
+            self.zpub = None
+
+
+class _Inbound:
+    """One topic's zenoh subscriber; hands checked, decoded messages to the bus."""
+
+    def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
+        self.transport = transport
+        self.topic = topic
+        self.msg_type = msg_type
+        self.type_hash = type_hash
+        self.prefix = f"{transport.domain_id}/{topic.strip('/')}/{dds_type(msg_type.__msgtype__)}"
+        self.subscriptions: list[Subscription[Any]] = []
+        self.zsub: Any = None
+        self.advanced = False
+        self.depth = 0
+        self.fallback = _Injector(transport._owner, msg_type, topic, _FALLBACK_QOS, "<zenoh>", hidden=True)
+
+    def declare(self, qos: QoSProfile) -> None:
+        import zenoh
+        import zenoh.ext
+
+        session = self.transport._session
+        want_history = qos.durability is DurabilityPolicy.TRANSIENT_LOCAL
+        depth = qos.depth if qos.history is HistoryPolicy.KEEP_LAST else 1000
+        if self.zsub is not None and (self.advanced or not want_history) and depth <= self.depth:
+            return
+        old = self.zsub
+        self.depth = max(depth, self.depth)
+        key = self.prefix + "/*"  # any hash: a mismatch is reported, not silently missed
+        if want_history or self.advanced:
+            reliable = qos.reliability is ReliabilityPolicy.RELIABLE
+            self.zsub = zenoh.ext.declare_advanced_subscriber(
+                session,
+                key,
+                self._on_sample,
+                allowed_origin=zenoh.Locality.REMOTE,
+                history=zenoh.ext.HistoryConfig(detect_late_publishers=True, max_samples=self.depth),
+                recovery=zenoh.ext.RecoveryConfig(periodic_queries=None, heartbeat=True) if reliable else None,
+                subscriber_detection=True,
+            )
+            self.advanced = True
+        else:
+            self.zsub = session.declare_subscriber(key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
+        if old is not None:
+            old.undeclare()
+
+    def _on_sample(self, sample: Any) -> None:
+        """On a zenoh thread: check and decode, then hand over to the main loop."""
+        transport = self.transport
+        from ..msgs import DeserializationError, deserialize
+
+        key = str(sample.key_expr)
+        try:
+            found_hash = key[len(self.prefix) + 1 :]
+            if found_hash != self.type_hash:
+                raise WireError(
+                    f"type hash on {self.topic}: expected {self.type_hash} for {self.msg_type.__msgtype__}, "
+                    f"found {found_hash or 'none'}; the two sides use different definitions"
+                )
+            raw = sample.attachment
+            attachment = unpack_attachment(None if raw is None else raw.to_bytes())
+            msg = deserialize(sample.payload.to_bytes(), self.msg_type)
+        except WireError as err:
+            transport._warn("wire", f"dropped a sample on {key}: {err}")
+            return
+        except DeserializationError as err:
+            transport._warn("cdr", f"dropped a sample on {key}: malformed CDR: {err}")
+            return
+        except Exception as err:  # noqa: BLE001 - nothing from the network may escape
+            transport._warn("other", f"dropped a sample on {key}: {type(err).__name__}: {err}")
+            return
+        transport._received += 1
+        transport._to_loop(transport._inject, self, attachment.gid, msg)
+
+    def close(self) -> None:
+        if self.zsub is not None:
+            self.zsub.undeclare()
+            self.zsub = None
+
+
+class ZenohTransport(Transport):
+    """Joins every aiorobot process (and ROS 2 node on rmw_zenoh) on the same zenoh network and domain.
+
+    Parameters
+    ----------
+    domain_id
+        ``ROS_DOMAIN_ID``: the first chunk of every key.
+    config_file
+        A zenoh JSON5 config file used as is (routers, TLS/mTLS, access control).
+        Without one: peer mode, listen on ``tcp/127.0.0.1:0``, connect to a router
+        on ``tcp/127.0.0.1:7447``, multicast scouting off (rmw_zenoh's defaults, on
+        loopback). ``ZENOH_SESSION_CONFIG_URI`` names a file too, and
+        ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``) applies last, as in rmw_zenoh.
+    connect, listen
+        Endpoints replacing the defaults.
+    """
+
+    name = "zenoh"
+
+    def __init__(
+        self,
+        *,
+        domain_id: int = 0,
+        config_file: str | None = None,
+        connect: list[str] | None = None,
+        listen: list[str] | None = None,
+    ) -> None:
+        super().__init__(domain_id=domain_id)
+        self.config_file = config_file
+        self.connect = connect
+        self.listen = listen
+        self._session: Any = None
+        self._zid = ""
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._owner: _Owner = None  # type: ignore[assignment]
+        self._lock = threading.RLock()
+        self._local = threading.local()
+        self._ids = itertools.count(1)
+        self._nodes: dict[int, _LocalNode] = {}
+        self._tokens: dict[int, Any] = {}  # id(endpoint) -> liveliness token
+        self._outbound: dict[tuple[str, str], _Outbound] = {}
+        self._inbound: dict[tuple[str, str], _Inbound] = {}
+        self._queryables: dict[int, Any] = {}
+        self._remote: dict[str, Any] = {}  # token -> what it added to the bus
+        self._remote_nodes: dict[str, NodeInfo] = {}
+        self._by_gid: dict[bytes, _Injector] = {}
+        self._liveliness_sub: Any = None
+        self._sent = 0
+        self._received = 0
+        self._drops: Counter[str] = Counter()
+        self._last_warning: dict[str, float] = {}
+        self._hashes: dict[Any, str] = {}
+
+    def __repr__(self) -> str:
+        state = f"zid={self._zid}" if self._session is not None else "closed"
+        return f"<ZenohTransport domain_id={self.domain_id} {state} remote_nodes={len(self._remote_nodes)}>"
+
+    # -- session --------------------------------------------------------------------
+
+    def _config(self) -> Any:
+        import json
+
+        import zenoh
+
+        path = self.config_file or os.environ.get("ZENOH_SESSION_CONFIG_URI")
+        if path:
+            try:
+                cfg = zenoh.Config.from_file(path)
+            except Exception as err:
+                raise ValueError(f"zenoh_config: cannot load {path!r}: {err}") from None
+        else:
+            cfg = zenoh.Config()
+            cfg.insert_json5("mode", '"peer"')
+            cfg.insert_json5("scouting/multicast/enabled", "false")
+            cfg.insert_json5("listen/endpoints", json.dumps(self.listen or [DEFAULT_LISTEN]))
+            cfg.insert_json5("connect/endpoints", json.dumps(self.connect if self.connect is not None else [DEFAULT_CONNECT]))
+        cfg.insert_json5("timestamping/enabled", "true")  # the advanced publisher's cache needs it
+        override = os.environ.get("ZENOH_CONFIG_OVERRIDE", "")
+        for item in filter(None, (part.strip() for part in override.split(";"))):
+            key, sep, value = item.partition("=")
+            if not sep:
+                raise ValueError(f"ZENOH_CONFIG_OVERRIDE: expected key=value, found {item!r}")
+            try:
+                cfg.insert_json5(key.strip(), value.strip())
+            except Exception as err:
+                raise ValueError(f"ZENOH_CONFIG_OVERRIDE: cannot set {key.strip()!r} to {value.strip()!r}: {err}") from None
+        return cfg
+
+    async def open(self, bus: Bus) -> None:
+        import zenoh
+
+        await super().open(bus)
+        self._loop = asyncio.get_running_loop()
+        self._owner = _Owner(self._loop, threading.get_ident(), "<zenoh>")
+        cfg = self._config()
+        self._session = await asyncio.to_thread(zenoh.open, cfg)
+        self._zid = str(self._session.zid())
+        bus.services.listener = self  # type: ignore[attr-defined]
+        self._liveliness_sub = self._session.liveliness().declare_subscriber(
+            f"@ros2_lv/{self.domain_id}/**", self._on_token, history=True
+        )
+
+    async def close(self) -> None:
+        session = self._session
+        if session is None:
+            return
+        if self._liveliness_sub is not None:
+            self._liveliness_sub.undeclare()
+        bus = self.bus
+        with self._lock:
+            for token in list(self._remote):
+                self._forget(token)
+            for out in self._outbound.values():
+                if bus is not None:
+                    bus.remove(out.tap)
+                out.close()
+            for inb in self._inbound.values():
+                if bus is not None:
+                    bus.remove(inb.fallback)
+                inb.close()
+            for q in self._queryables.values():
+                q.undeclare()
+            for token in [*self._tokens.values(), *(n.token for n in self._nodes.values())]:
+                token.undeclare()
+            self._outbound.clear()
+            self._inbound.clear()
+            self._queryables.clear()
+            self._tokens.clear()
+            self._nodes.clear()
+        if bus is not None and getattr(bus.services, "listener", None) is self:
+            bus.services.listener = None  # type: ignore[attr-defined]
+        self._session = None
+        await asyncio.to_thread(session.close)
+        await super().close()
+
+    @property
+    def zid(self) -> str:
+        return self._zid
+
+    def statistics(self) -> TransportStatistics:
+        return TransportStatistics(
+            self._sent, self._received, sum(self._drops.values()), dict(self._drops), len(self._remote_nodes)
+        )
+
+    def remote_nodes(self) -> tuple[NodeInfo, ...]:
+        return tuple(self._remote_nodes.values())
+
+    # -- helpers --------------------------------------------------------------------------
+
+    def _warn(self, reason: str, text: str) -> None:
+        self._drops[reason] += 1
+        now = time.monotonic()
+        if now - self._last_warning.get(reason, -1e9) >= WARN_INTERVAL_SEC:
+            self._last_warning[reason] = now
+            _log.warning(f"{text} ({self._drops[reason]} dropped so far for this reason)")
+
+    def _to_loop(self, fn: Any, *args: Any) -> None:
+        loop = self._loop
+        if loop is not None and not loop.is_closed():
+            try:
+                loop.call_soon_threadsafe(fn, *args)
+            except RuntimeError:
+                pass
+
+    def _hash(self, msg_type: Any) -> str:
+        cached = self._hashes.get(msg_type)
+        if cached is None:
+            from ..msgs import type_hash
+
+            cached = self._hashes[msg_type] = type_hash(msg_type)
+        return cached
+
+    def _node(self, node: Node) -> _LocalNode:
+        entry = self._nodes.get(id(node))
+        if entry is None:
+            nid = next(self._ids)
+            token = self._session.liveliness().declare_token(
+                node_token(self.domain_id, self._zid, nid, "", node.get_namespace() or "/", node.get_name())
+            )
+            entry = self._nodes[id(node)] = _LocalNode(nid, token)
+        return entry
+
+    def _declare_endpoint(self, endpoint: Any, kind: str, name: str, type_name: str, type_hash: str, qos: QoSProfile) -> str:
+        node = endpoint.node
+        entry = self._node(node)
+        token = endpoint_token(
+            self.domain_id, self._zid, entry.nid, next(self._ids), kind, "",
+            node.get_namespace() or "/", node.get_name(), name, type_name, type_hash, qos,
+        )
+        self._tokens[id(endpoint)] = self._session.liveliness().declare_token(token)
+        return token
+
+    def _drop_token(self, endpoint: Any) -> None:
+        token = self._tokens.pop(id(endpoint), None)
+        if token is not None:
+            token.undeclare()
+
+    # -- nodes ---------------------------------------------------------------------------
+
+    def node_added(self, node: Node) -> None:
+        if self._session is None:
+            return
+        with self._lock:
+            self._node(node)
+
+    def node_removed(self, node: Node) -> None:
+        with self._lock:
+            entry = self._nodes.pop(id(node), None)
+            if entry is not None and self._session is not None:
+                entry.token.undeclare()
+
+    # -- local endpoints ------------------------------------------------------------------
+
+    def endpoint_added(self, endpoint: Any) -> None:
+        if self._session is None or isinstance(endpoint, (_Injector, Tap)):
+            return
+        with self._lock:
+            if isinstance(endpoint, Publisher):
+                self._add_publisher(endpoint)
+            elif isinstance(endpoint, Subscription):
+                self._add_subscription(endpoint)
+            elif isinstance(endpoint, Service):
+                self._add_service(endpoint)
+            elif isinstance(endpoint, Client):
+                self._declare_endpoint(
+                    endpoint, "SC", endpoint.srv_name, endpoint.type_name, self._hash(endpoint.srv_type), QoSProfile()
+                )
+
+    def endpoint_removed(self, endpoint: Any) -> None:
+        if self._session is None or isinstance(endpoint, (_Injector, Tap)):
+            return
+        with self._lock:
+            self._drop_token(endpoint)
+            if isinstance(endpoint, Publisher):
+                out = self._outbound.get((endpoint.topic_name, endpoint.type_name))
+                if out is not None and endpoint in out.publishers:
+                    out.publishers.remove(endpoint)
+                    if not out.publishers:
+                        del self._outbound[(out.topic, endpoint.type_name)]
+                        if self.bus is not None:
+                            self.bus.remove(out.tap)
+                        out.close()
+            elif isinstance(endpoint, Subscription):
+                inb = self._inbound.get((endpoint.topic_name, endpoint.type_name))
+                if inb is not None and endpoint in inb.subscriptions:
+                    inb.subscriptions.remove(endpoint)
+                    if not inb.subscriptions:
+                        del self._inbound[(inb.topic, endpoint.type_name)]
+                        if self.bus is not None:
+                            self.bus.remove(inb.fallback)
+                        inb.close()
+            elif isinstance(endpoint, Service):
+                q = self._queryables.pop(id(endpoint), None)
+                if q is not None:
+                    q.undeclare()
+
+    def _add_publisher(self, pub: Publisher[Any]) -> None:
+        type_hash = self._hash(pub.msg_type)
+        token = self._declare_endpoint(pub, "MP", pub.topic_name, pub.type_name, type_hash, pub.qos)
+        key = (pub.topic_name, pub.type_name)
+        out = self._outbound.get(key)
+        new = out is None
+        if out is None:
+            out = self._outbound[key] = _Outbound(self, pub.topic_name, pub.msg_type, type_hash)
+            out.gid = gid_of(token)
+        out.declare(pub.qos)
+        out.publishers.append(pub)
+        if new and self.bus is not None:
+            self.bus.add_subscription(out.tap)
+
+    def _add_subscription(self, sub: Subscription[Any]) -> None:
+        type_hash = self._hash(sub.msg_type)
+        self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
+        key = (sub.topic_name, sub.type_name)
+        inb = self._inbound.get(key)
+        new = inb is None
+        if inb is None:
+            inb = self._inbound[key] = _Inbound(self, sub.topic_name, sub.msg_type, type_hash)
+        inb.subscriptions.append(sub)
+        if new and self.bus is not None:
+            self.bus.add_publisher(inb.fallback)
+        inb.declare(sub.qos)
+
+    def _inject(self, inbound: _Inbound, gid: bytes, msg: Any) -> None:
+        """On the main loop: publish a received message into the bus as its remote publisher."""
+        injector = self._by_gid.get(gid)
+        if injector is None or injector.topic_name != inbound.topic or injector.msg_type is not inbound.msg_type:
+            injector = inbound.fallback
+        if injector.destroyed:
+            return
+        self._local.injecting = True
+        try:
+            injector.publish(msg)
+        except Exception as err:  # noqa: BLE001
+            self._warn("inject", f"could not deliver a message on {inbound.topic}: {err}")
+        finally:
+            self._local.injecting = False
+
+    # -- services --------------------------------------------------------------------------
+
+    def _add_service(self, service: Service) -> None:
+        import zenoh
+
+        type_hash = self._hash(service.srv_type)
+        self._declare_endpoint(service, "SS", service.srv_name, service.type_name, type_hash, QoSProfile())
+        key = data_key(self.domain_id, service.srv_name, service.type_name, type_hash)
+
+        def on_query(query: Any) -> None:
+            self._on_query(service, query)
+
+        self._queryables[id(service)] = self._session.declare_queryable(
+            key, on_query, complete=True, allowed_origin=zenoh.Locality.REMOTE
+        )
+
+    def _on_query(self, service: Service, query: Any) -> None:
+        """On a zenoh thread: decode a request, then serve it like a local call."""
+        from ..msgs import DeserializationError, deserialize
+
+        key = str(query.key_expr)
+        try:
+            raw = query.attachment
+            attachment = unpack_attachment(None if raw is None else raw.to_bytes())
+            payload = query.payload
+            request = deserialize(b"" if payload is None else payload.to_bytes(), service.srv_type.Request)
+        except (WireError, DeserializationError) as err:
+            self._warn("query", f"dropped a request on {key}: {err}")
+            query.drop()
+            return
+        self._received += 1
+        self._to_loop(self._serve, service, query, attachment, request)
+
+    def _serve(self, service: Service, query: Any, attachment: Any, request: Any) -> None:
+        loop = asyncio.get_running_loop()
+        future: asyncio.Future[Any] = loop.create_future()
+
+        def done(fut: asyncio.Future[Any]) -> None:
+            from ..msgs import serialize
+
+            try:
+                if fut.cancelled():
+                    query.reply_err(f"service {service.srv_name} was cancelled".encode())
+                elif fut.exception() is not None:
+                    query.reply_err(str(fut.exception()).encode())
+                else:
+                    att = pack_attachment(attachment.sequence, time.time_ns(), attachment.gid)
+                    query.reply(query.key_expr, serialize(fut.result()), attachment=att)
+                    self._sent += 1
+            except Exception as err:  # noqa: BLE001
+                self._warn("reply", f"could not answer a request on {service.srv_name}: {err}")
+            finally:
+                query.drop()
+
+        future.add_done_callback(done)
+        service.node._call_soon(service._enqueue, _Call(request, loop, future))
+
+    def _query(self, server: _RemoteServer, call: _Call) -> None:
+        """Send ``call`` to a remote server; the reply completes the caller's future."""
+        import zenoh
+
+        from ..msgs import DeserializationError, deserialize, serialize
+
+        state = {"answered": False}
+        gid = self._client_gid
+        seq = next(self._ids)
+
+        def on_reply(reply: Any) -> None:
+            if state["answered"]:
+                return
+            state["answered"] = True
+            if reply.ok is None:
+                err = reply.err
+                text = err.payload.to_bytes().decode(errors="replace") if err is not None else "error"
+                _reply(call, exc=ServiceError(f"service {server.srv_name} failed: {text}"))
+                return
+            try:
+                response = deserialize(reply.ok.payload.to_bytes(), server.srv_type.Response)
+            except DeserializationError as err:
+                self._warn("reply", f"dropped a reply on {server.srv_name}: {err}")
+                _reply(call, exc=ServiceError(f"service {server.srv_name} sent a malformed reply: {err}"))
+                return
+            self._received += 1
+            _reply(call, result=response)
+
+        def on_done() -> None:
+            if not state["answered"]:
+                _reply(call, exc=ServiceError(f"service {server.srv_name} ended the call without a reply"))
+
+        try:
+            payload = serialize(call.request)
+            self._session.get(
+                server.key,
+                zenoh.handlers.Callback(on_reply, on_done),
+                target=zenoh.QueryTarget.ALL_COMPLETE,
+                consolidation=zenoh.ConsolidationMode.NONE,
+                payload=payload,
+                attachment=pack_attachment(seq, time.time_ns(), gid),
+                timeout=QUERY_TIMEOUT_SEC,
+            )
+            self._sent += 1
+        except Exception as err:  # noqa: BLE001
+            _reply(call, exc=ServiceError(f"service {server.srv_name}: could not send the request: {err}"))
+
+    @property
+    def _client_gid(self) -> bytes:
+        return gid_of(f"@ros2_lv/{self.domain_id}/{self._zid}/client")
+
+    # -- discovery -------------------------------------------------------------------------
+
+    def _on_token(self, sample: Any) -> None:
+        import zenoh
+
+        alive = sample.kind == zenoh.SampleKind.PUT
+        self._to_loop(self._token_event, str(sample.key_expr), alive)
+
+    def _token_event(self, token: str, alive: bool) -> None:
+        """On the main loop: a remote entity appeared or left."""
+        if self.bus is None:
+            return
+        try:
+            info = parse_token(token)
+        except WireError as err:
+            self._warn("token", f"ignored a liveliness token: {err}")
+            return
+        if info.zid == self._zid:
+            return
+        with self._lock:
+            if not alive:
+                self._forget(token)
+                return
+            if token in self._remote:
+                return
+            try:
+                self._learn(info)
+            except Exception as err:  # noqa: BLE001 - a bad peer must not break discovery
+                self._warn("token", f"could not add remote {info.kind} {info.topic or info.node}: {err}")
+
+    def _learn(self, info: Any) -> None:
+        from .._graph import NodeInfo
+        from ..msgs import get
+
+        bus = self.bus
+        assert bus is not None
+        if info.kind == "NN":
+            self._remote_nodes[info.token] = NodeInfo(info.node, info.namespace, info.node_fqn, "remote")
+            self._remote[info.token] = None
+            return
+        try:
+            cls = get(info.type_name)
+        except Exception:
+            self._remote[info.token] = None  # a type this process does not know: nothing to deliver
+            return
+        local_hash = self._hash(cls)
+        if local_hash != info.type_hash:
+            self._warn(
+                "type_hash",
+                f"remote {info.kind} of {info.node_fqn} on {info.topic} uses {info.type_name} with hash "
+                f"{info.type_hash}, this process has {local_hash}: they do not connect",
+            )
+            self._remote[info.token] = None
+            return
+        if info.kind == "MP":
+            injector = _Injector(self._owner, cls, info.topic, info.qos, info.node_fqn)
+            self._remote[info.token] = injector
+            self._by_gid[gid_of(info.token)] = injector
+            self._add_to_bus(injector)
+        elif info.kind == "MS":
+            tap = Tap(cls, info.topic, info.qos, _ignore, owner=info.node_fqn)
+            self._remote[info.token] = tap
+            self._add_to_bus(tap)
+        elif info.kind == "SS":
+            key = data_key(self.domain_id, info.topic, info.type_name, info.type_hash)
+            server = _RemoteServer(self, cls, info.topic, key, info.node_fqn)
+            self._remote[info.token] = server
+            bus.services.add(server)  # type: ignore[arg-type]
+        elif info.kind == "SC":
+            client = _RemoteClient(info.type_name, info.topic, info.node_fqn)
+            self._remote[info.token] = client
+            bus.services.add(client)  # type: ignore[arg-type]
+
+    def _add_to_bus(self, endpoint: Any) -> None:
+        assert self.bus is not None
+        try:
+            if isinstance(endpoint, Publisher):
+                self.bus.add_publisher(endpoint)
+            else:
+                self.bus.add_subscription(endpoint)
+        except Exception as err:  # noqa: BLE001 - strict_qos refuses it: the warning is the report
+            _log.error(f"remote endpoint not connected: {err}")
+            self._remote[next(t for t, e in self._remote.items() if e is endpoint)] = None
+
+    def _forget(self, token: str) -> None:
+        entry = self._remote.pop(token, None)
+        self._remote_nodes.pop(token, None)
+        bus = self.bus
+        if entry is None or bus is None:
+            return
+        if isinstance(entry, _Injector):
+            self._by_gid.pop(gid_of(token), None)
+            entry.destroyed = True
+            bus.remove(entry)
+        elif isinstance(entry, Tap):
+            bus.remove(entry)
+        else:
+            entry.destroyed = True
+            bus.services.remove(entry)
+
+
+def _ignore(_msg: Any) -> None:
+    """A remote subscription's tap: the sender tap of the topic does the sending."""
