@@ -45,7 +45,7 @@ __all__ = [
 EXECUTORS = ("main", "priority")
 LOG_LEVELS = ("debug", "info", "warning", "error")
 TRANSPORTS = ("local", "zenoh")
-_AVAILABLE_TRANSPORTS = ("local",)
+_AVAILABLE_TRANSPORTS = ("local", "zenoh")
 _MAX_DOMAIN_ID = 232
 
 _RUNTIME_KEYS = (
@@ -59,6 +59,7 @@ _RUNTIME_KEYS = (
     "parameters_file",
     "record",
     "foxglove",
+    "zenoh_config",
 )
 _NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file")
 _RECORD_KEYS = ("path", "topics", "exclude", "compression", "max_bag_size", "max_bag_duration", "max_cache_size")
@@ -112,6 +113,7 @@ class RuntimeConfig:
     priority_realtime: bool = False
     debug_messages: bool = False
     parameters_file: str | None = None  # a ROS 2 YAML parameter file for every node (absolute path)
+    zenoh_config: str | None = None  # a zenoh session config file (JSON5) for routers, TLS, access control
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,8 +275,17 @@ def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
     debug_messages = table.get("debug_messages", False)
     checker.check_type(debug_messages, "runtime.debug_messages", bool, "true or false")
     parameters_file = _parameters_file(checker, table, "runtime")
+    zenoh_config = table.get("zenoh_config")
+    if zenoh_config is not None:
+        checker.check_type(zenoh_config, "runtime.zenoh_config", str, "a path to a zenoh config file (JSON5)")
+        resolved = (Path(checker.path).resolve().parent / zenoh_config).resolve()
+        if not resolved.is_file():
+            raise checker.error("runtime.zenoh_config", f"expected a zenoh config file, found no file at {resolved}")
+        if transport != "zenoh":
+            raise checker.error("runtime.zenoh_config", 'only applies with transport = "zenoh"')
+        zenoh_config = str(resolved)
     return RuntimeConfig(
-        transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file
+        transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file, zenoh_config
     )
 
 

@@ -103,6 +103,8 @@ class Runtime:
             cfg = load_config(os.fspath(config)) if isinstance(config, (str, os.PathLike)) else config
             self._config = cfg
             transport = cfg.runtime.transport
+            if cfg.runtime.zenoh_config:
+                transport = make_transport("zenoh", domain_id=cfg.runtime.domain_id, config_file=cfg.runtime.zenoh_config)
             domain_id = cfg.runtime.domain_id
             use_sim_time = cfg.runtime.use_sim_time
             strict_qos = cfg.runtime.strict_qos

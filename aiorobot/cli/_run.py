@@ -12,7 +12,7 @@ import logging
 import signal
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ._parser import positive_seconds
 
@@ -110,8 +110,13 @@ async def _serve(config: GraphConfig, duration_sec: float | None, status_period_
     loop = asyncio.get_running_loop()
     signals = (signal.SIGINT, signal.SIGTERM)
     try:
+        from aiorobot._transport import make_transport
+
+        transport: Any = runtime_config.transport
+        if runtime_config.zenoh_config:
+            transport = make_transport("zenoh", domain_id=runtime_config.domain_id, config_file=runtime_config.zenoh_config)
         async with Runtime(
-            transport=runtime_config.transport,
+            transport=transport,
             domain_id=runtime_config.domain_id,
             use_sim_time=runtime_config.use_sim_time,
             strict_qos=runtime_config.strict_qos,
