@@ -10,6 +10,7 @@ Nodes: :class:`EkfNode` (robot_localization's ``ekf_node`` parameters and topics
 
 from __future__ import annotations
 
+from ._timeline import FilterTimeline, Measurement
 from ._ekf import DEFAULT_PROCESS_NOISE, STATE_NAMES, STATE_SIZE, Correction, Ekf, check_covariance, force_two_d
 
 __all__ = [
@@ -18,6 +19,8 @@ __all__ = [
     "STATE_SIZE",
     "Correction",
     "Ekf",
+    "FilterTimeline",
+    "Measurement",
     "check_covariance",
     "force_two_d",
 ]
