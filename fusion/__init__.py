@@ -10,15 +10,21 @@ Nodes: :class:`EkfNode` (robot_localization's ``ekf_node`` parameters and topics
 
 from __future__ import annotations
 
-from ._timeline import FilterTimeline, Measurement
+from ._complementary import ComplementaryEstimator
+from ._complementary_node import ComplementaryFilter
 from ._ekf import DEFAULT_PROCESS_NOISE, STATE_NAMES, STATE_SIZE, Correction, Ekf, check_covariance, force_two_d
+from ._ekf_node import EkfNode
+from ._timeline import FilterTimeline, Measurement
 
 __all__ = [
     "DEFAULT_PROCESS_NOISE",
     "STATE_NAMES",
     "STATE_SIZE",
+    "ComplementaryEstimator",
+    "ComplementaryFilter",
     "Correction",
     "Ekf",
+    "EkfNode",
     "FilterTimeline",
     "Measurement",
     "check_covariance",
