@@ -37,7 +37,7 @@ STATE_NAMES = (
 DEFAULT_PROCESS_NOISE = np.diag(
     [0.05, 0.05, 0.06, 0.03, 0.03, 0.06, 0.025, 0.025, 0.04, 0.01, 0.01, 0.02, 0.01, 0.01, 0.015]
 )
-_THREE_D = (2, 3, 4, 8, 9, 10, 14)  # z roll pitch vz vroll vpitch az
+_THREE_D_INDEX = np.array([2, 3, 4, 8, 9, 10, 14])  # z roll pitch vz vroll vpitch az
 
 _kernels: ModuleType | None = None
 
@@ -73,16 +73,40 @@ def _check_state(name: str, value: ArrayLike) -> NDArray[np.float64]:
     return arr
 
 
+_REASONS = {
+    1: "no finite member selected",
+    2: "covariance is not finite",
+    3: "innovation covariance is singular",
+    4: "Mahalanobis distance over the rejection threshold",
+}
+
+
+def _is_float_matrix(a: object) -> bool:
+    return type(a) is np.ndarray and a.dtype == np.float64 and a.shape == (STATE_SIZE, STATE_SIZE)  # type: ignore[union-attr]
+
+
+def _as_vector(z: ArrayLike) -> NDArray[np.float64]:
+    if type(z) is np.ndarray and z.dtype == np.float64 and z.shape == (STATE_SIZE,):
+        return z
+    return _check_state("z", z)
+
+
+def _as_mask(mask: ArrayLike) -> NDArray[np.bool_]:
+    mk = np.asarray(mask, dtype=bool).reshape(-1)
+    if mk.shape != (STATE_SIZE,):
+        raise ValueError(f"mask: expected {STATE_SIZE} booleans, got shape {mk.shape}")
+    return mk
+
+
 def force_two_d(
     z: NDArray[np.float64], R: NDArray[np.float64], mask: NDArray[np.bool_]
 ) -> None:
     """robot_localization's ``forceTwoD``: measure z, roll, pitch, vz, vroll, vpitch, az as 0 (var 1e-6)."""
-    for i in _THREE_D:
-        z[i] = 0.0
-        R[i, :] = 0.0
-        R[:, i] = 0.0
-        R[i, i] = 1e-6
-        mask[i] = True
+    z[_THREE_D_INDEX] = 0.0
+    R[_THREE_D_INDEX, :] = 0.0
+    R[:, _THREE_D_INDEX] = 0.0
+    R[_THREE_D_INDEX, _THREE_D_INDEX] = 1e-6
+    mask[_THREE_D_INDEX] = True
 
 
 @dataclass(frozen=True)
@@ -162,24 +186,14 @@ class Ekf:
         value, variances below 1e-9 are raised to 1e-9, angle innovations are wrapped, and a
         measurement whose squared Mahalanobis distance is >= ``mahalanobis_threshold**2`` is rejected.
         """
-        zv = _check_state("z", z)
-        Rm = check_covariance("R", R)
-        mk = np.asarray(mask, dtype=bool).reshape(-1)
-        if mk.shape != (STATE_SIZE,):
-            raise ValueError(f"mask: expected {STATE_SIZE} booleans, got shape {mk.shape}")
-        idx = np.flatnonzero(mk & np.isfinite(zv)).astype(np.int64)
-        if idx.size == 0:
-            return Correction(False, 0.0, "no finite member selected")
-        sub = Rm[np.ix_(idx, idx)]
-        if not np.all(np.isfinite(sub)):
-            return Correction(False, math.inf, "covariance is not finite")
-        threshold_sq = math.inf if math.isinf(mahalanobis_threshold) else float(mahalanobis_threshold) ** 2
-        d2 = _k().correct_inplace(self.state, self.covariance, zv, Rm, idx, threshold_sq)
-        if d2 < threshold_sq:
-            return Correction(True, float(d2))
-        if math.isinf(d2):
-            return Correction(False, d2, "innovation covariance is singular")
-        return Correction(False, float(d2), "Mahalanobis distance over the rejection threshold")
+        zv = _as_vector(z)
+        Rm = R if _is_float_matrix(R) else check_covariance("R", R)
+        mk = mask if (type(mask) is np.ndarray and mask.dtype == np.bool_ and mask.shape == (STATE_SIZE,)) else _as_mask(mask)
+        threshold_sq = math.inf if mahalanobis_threshold == math.inf else float(mahalanobis_threshold) ** 2
+        status, d2 = _k().correct_inplace(self.state, self.covariance, zv, Rm, mk, threshold_sq)
+        if status == 0:
+            return Correction(True, d2)
+        return Correction(False, d2, _REASONS[status])
 
     def snapshot(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Copies of ``(state, covariance)``."""

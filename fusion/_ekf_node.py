@@ -29,10 +29,6 @@ __all__ = ["EkfNode"]
 _NS = 1_000_000_000
 
 
-def _stamp_sec(stamp: Any) -> float:
-    return stamp.sec + stamp.nanosec * 1e-9
-
-
 def _quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
@@ -89,6 +85,8 @@ class EkfNode(Node):
         self._trackers: dict[str, PoseTracker] = {}
         self._last_input_wall = time.monotonic()
         self._last_published_stamp = -math.inf
+        # filter time is seconds since the first stamp seen: exact to the nanosecond for days
+        self._origin_ns: int | None = None
         from aiorobot.msgs.nav_msgs import Odometry
 
         self._odometry_type = Odometry
@@ -202,6 +200,20 @@ class EkfNode(Node):
         self.create_service(SetBool, "toggle", self._on_toggle)
         self.create_service(Empty, "reset", self._on_reset)
 
+    # -- time --------------------------------------------------------------------------------
+    def _sec(self, ns: int) -> float:
+        if self._origin_ns is None:
+            self._origin_ns = ns
+        return (ns - self._origin_ns) * 1e-9
+
+    def _stamp_sec(self, stamp: Any) -> float:
+        """Filter seconds of a header stamp; a zero stamp means now."""
+        ns = stamp.sec * _NS + stamp.nanosec
+        return self._sec(ns if ns else self.now().nanoseconds)
+
+    def _now_sec(self) -> float:
+        return self._sec(self.now().nanoseconds)
+
     # -- inputs -------------------------------------------------------------------------------
     def _reject(self, cfg_name: str, reason: str) -> None:
         self.rejected[(cfg_name, reason)] += 1
@@ -212,10 +224,8 @@ class EkfNode(Node):
         self.received[cfg.name] += 1
         if not self.enabled:
             return
-        stamp = _stamp_sec(msg.header.stamp)
-        now = self.now().nanoseconds / _NS
-        if stamp == 0.0:
-            stamp = now
+        stamp = self._stamp_sec(msg.header.stamp)
+        now = self._now_sec()
         try:
             if not cfg.config.any():
                 raise InputRejected(f"{cfg.name}_config selects no state member")
@@ -308,7 +318,7 @@ class EkfNode(Node):
         state[3:6] = rpy_from_rotation(R)
         P = np.eye(STATE_SIZE) * 1e-9
         P[:6, :6] = cov
-        stamp = _stamp_sec(msg.header.stamp) or self.now().nanoseconds / _NS
+        stamp = self._stamp_sec(msg.header.stamp)
         self.timeline.set_state(stamp, state, P, np.ones(STATE_SIZE, bool))
         for tracker in self._trackers.values():
             tracker.first = tracker.previous = None
@@ -339,7 +349,7 @@ class EkfNode(Node):
         if not (self.enabled and self.timeline.initialized):
             return
         if time.monotonic() - self._last_input_wall > self.sensor_timeout:
-            self.timeline.predict_to(self.now().nanoseconds / _NS)
+            self.timeline.predict_to(self._now_sec())
             self.publish_state()
 
     def publish_state(self) -> None:
@@ -352,10 +362,10 @@ class EkfNode(Node):
             self.timeline.reset()
             return
         stamp_sec = self.timeline.stamp_sec
-        sec = math.floor(stamp_sec)
         from aiorobot.msgs.builtin_interfaces import Time as TimeMsg
 
-        stamp = TimeMsg(sec=int(sec), nanosec=min(int(round((stamp_sec - sec) * _NS)), _NS - 1))
+        sec, nanosec = divmod((self._origin_ns or 0) + round(stamp_sec * _NS), _NS)
+        stamp = TimeMsg(sec=int(sec), nanosec=int(nanosec))
         q = _quaternion_from_rpy(x[3], x[4], x[5])
         msg = self._odometry_type()
         msg.header.stamp = stamp

@@ -160,15 +160,30 @@ def _invert(S: np.ndarray) -> tuple[np.ndarray, bool]:
 
 @numba.njit(cache=True, nogil=True)
 def correct_inplace(
-    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, idx: np.ndarray, threshold_sq: float
-) -> float:
-    """Correct with the state members ``idx`` measured as ``z[idx]`` with covariance ``R[idx][:, idx]``.
+    x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray, mask: np.ndarray, threshold_sq: float
+) -> tuple[int, float]:
+    """Correct with the finite members of ``z`` selected by ``mask``, covariance ``R[idx][:, idx]``.
 
-    Joseph-form covariance update as in ekf.cpp. Returns the squared Mahalanobis distance of the
-    innovation; when it is >= ``threshold_sq`` (or the innovation covariance is singular) the state is
-    left untouched and the return value is that distance (``inf`` when singular).
+    Joseph-form covariance update as in ekf.cpp. Returns ``(status, squared Mahalanobis distance)``:
+    0 applied; 1 no finite member selected; 2 covariance not finite; 3 innovation covariance
+    singular; 4 distance >= ``threshold_sq`` (state untouched unless 0).
     """
-    m = idx.shape[0]
+    m = 0
+    for i in range(15):
+        if mask[i] and math.isfinite(z[i]):
+            m += 1
+    if m == 0:
+        return 1, 0.0
+    idx = np.empty(m, np.int64)
+    m = 0
+    for i in range(15):
+        if mask[i] and math.isfinite(z[i]):
+            idx[m] = i
+            m += 1
+    for a in range(m):
+        for b in range(m):
+            if not math.isfinite(R[idx[a], idx[b]]):
+                return 2, math.inf
     S = np.empty((m, m))
     nu = np.empty(m)
     Rs = np.empty((m, m))
@@ -188,7 +203,7 @@ def correct_inplace(
             S[a, b] = P[idx[a], idx[b]] + Rs[a, b]
     Sinv, ok = _invert(S)
     if not ok:
-        return math.inf
+        return 3, math.inf
     d2 = 0.0
     for a in range(m):
         s = 0.0
@@ -196,7 +211,7 @@ def correct_inplace(
             s += Sinv[a, b] * nu[b]
         d2 += nu[a] * s
     if not (d2 < threshold_sq):
-        return d2
+        return 4, d2
     # K = P H^T S^-1  (15 x m)
     K = np.zeros((15, m))
     for i in range(15):
@@ -233,4 +248,42 @@ def correct_inplace(
                 s += -A[i, idx[a]] * K[j, a] + KR[i, a] * K[j, a]
             P[i, j] = s
     wrap_angles_inplace(x)
-    return d2
+    return 0, d2
+
+
+@numba.njit(cache=True, nogil=True)
+def covariance_status(C: np.ndarray) -> int:
+    """0 when ``C`` (n x n) is finite, symmetric and positive semi-definite; else 1, 2 or 3 (which failed).
+
+    Tolerances scale with ``max(1, max|C|)``: 1e-9 for symmetry, and PSD means a Cholesky
+    factorisation of ``C + 1e-9 * scale * I`` succeeds.
+    """
+    n = C.shape[0]
+    scale = 1.0
+    for i in range(n):
+        for j in range(n):
+            v = C[i, j]
+            if not math.isfinite(v):
+                return 1
+            if abs(v) > scale:
+                scale = abs(v)
+    tol = 1e-9 * scale
+    for i in range(n):
+        for j in range(i + 1, n):
+            if abs(C[i, j] - C[j, i]) > tol:
+                return 2
+    L = np.zeros((n, n))
+    for j in range(n):
+        s = C[j, j] + tol
+        for k in range(j):
+            s -= L[j, k] * L[j, k]
+        if s <= 0.0:
+            return 3
+        d = math.sqrt(s)
+        L[j, j] = d
+        for i in range(j + 1, n):
+            t = C[i, j]
+            for k in range(j):
+                t -= L[i, k] * L[j, k]
+            L[i, j] = t / d
+    return 0

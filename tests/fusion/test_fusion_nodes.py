@@ -236,3 +236,37 @@ async def test_complementary_filter_publishes_fused_orientation_with_the_imu_sta
         yaw = 2 * math.atan2(last.orientation.z, last.orientation.w)
         assert yaw == pytest.approx(0.1, abs=1e-9)  # no odometry yet: the gyro alone
         assert node.estimator.steps == 11
+
+
+async def test_example_config_builds_both_filters_on_the_priority_loop_and_fuses_odometry(tmp_path):
+    from pathlib import Path
+
+    from aiorobot._config import build_nodes, load_config
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "fusion_ekf.toml"
+    built = build_nodes(load_config(example))
+    assert [(type(n).__name__, ex) for n, ex in built] == [("EkfNode", "priority"), ("EkfNode", "priority")]
+    async with Runtime() as rt:
+        probe = rt.add_node(Probe())
+        local: list[Odometry] = []
+        probe.create_subscription(Odometry, "/local/odometry/filtered", local.append, 100)
+        for node, executor in built:
+            rt.add_node(node, executor=executor)
+        t0 = _now(rt)
+        for k in range(5):
+            probe.odom(t0 + 0.02 * k, vx=0.5)
+        await until(lambda: len(local) >= 5)
+        assert local[-1].twist.twist.linear.x == pytest.approx(0.5, abs=1e-3)
+        assert local[-1].header.frame_id == "odom"
+
+
+def test_config_with_a_misspelt_parameter_names_the_nearest_valid_one(tmp_path):
+    from aiorobot._config import ConfigError, build_nodes, load_config
+
+    path = tmp_path / "bad.toml"
+    path.write_text(
+        '[[nodes]]\nuse = "aiorobot.fusion:EkfNode"\nexecutor = "priority"\n'
+        'parameters = { odom0 = "/odom", odom0_confg = [true, true] }\n'
+    )
+    with pytest.raises(ConfigError, match=r'unknown robot_localization parameter "odom0_confg"; did you mean "odom0_config"\?'):
+        build_nodes(load_config(path))
