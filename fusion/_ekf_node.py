@@ -227,7 +227,7 @@ class EkfNode(Node):
         stamp = self._stamp_sec(msg.header.stamp)
         now = self._now_sec()
         try:
-            if not cfg.config.any():
+            if not cfg.uses_any:
                 raise InputRejected(f"{cfg.name}_config selects no state member")
             if stamp > now + self.future_tolerance_sec:
                 raise InputRejected(f"stamp more than future_tolerance_sec={self.future_tolerance_sec} s ahead of the clock")
@@ -255,7 +255,7 @@ class EkfNode(Node):
         out: list[Measurement | None] = []
         if cfg.kind in ("odom", "pose"):
             pose = msg.pose
-            if cfg.config[:6].any():
+            if cfg.uses_pose:
                 self._frame_check(cfg, msg.header.frame_id, self.world_frame if not cfg.differential and not cfg.relative else msg.header.frame_id, "pose")
             p, q = pose.pose.position, pose.pose.orientation
             out.append(
@@ -263,7 +263,7 @@ class EkfNode(Node):
             )
         if cfg.kind in ("odom", "twist"):
             twist = msg.twist
-            if cfg.config[6:12].any():
+            if cfg.uses_twist:
                 frame = msg.child_frame_id if cfg.kind == "odom" else msg.header.frame_id
                 self._frame_check(cfg, frame, self.base_link_frame, "twist")
             lin, ang = twist.twist.linear, twist.twist.angular
@@ -357,7 +357,7 @@ class EkfNode(Node):
         if not self.timeline.initialized:
             return
         x, P = self.ekf.state, self.ekf.covariance
-        if not np.all(np.isfinite(x)):  # never publish NaN: start over from the initial estimate
+        if not math.isfinite(float(x.sum())):  # never publish NaN: start over from the initial estimate
             self._reject("filter", "state became non-finite; reset to the initial estimate")
             self.timeline.reset()
             return

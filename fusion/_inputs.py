@@ -41,6 +41,13 @@ class InputConfig:
     remove_gravitational_acceleration: bool = False
     gravitational_acceleration: float = 9.80665
 
+    def __post_init__(self) -> None:
+        c = np.asarray(self.config, dtype=bool)
+        self.config = c
+        self.uses_any = bool(c.any())
+        self.uses_pose = bool(c[:6].any())
+        self.uses_twist = bool(c[6:12].any())
+
 
 @dataclass
 class PoseTracker:
@@ -120,7 +127,7 @@ def pose_measurement(
     applied to the velocity members selected by the pose booleans, as robot_localization does.
     """
     mask6 = cfg.config[:6]
-    if not mask6.any():
+    if not cfg.uses_pose:
         return None
     _finite6(f"{cfg.name} pose", position, quaternion)
     C = check_message_covariance(f"{cfg.name} pose", covariance, 6)
@@ -159,7 +166,7 @@ def twist_measurement(
 ) -> Measurement | None:
     """The twist part of an ``odomN``/``twistN`` message (body frame)."""
     mask6 = cfg.config[6:12]
-    if not mask6.any():
+    if not cfg.uses_twist:
         return None
     _finite6(f"{cfg.name} twist", linear, angular)
     C = check_message_covariance(f"{cfg.name} twist", covariance, 6)
