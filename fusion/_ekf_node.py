@@ -93,13 +93,16 @@ class EkfNode(Node):
         self.odom_pub = self.create_publisher(Odometry, "odometry/filtered", 10)
         self._tf = None
         self._tf_buffer = None
-        if self.publish_tf or any(kind == "imu" for _, kind in input_names(given)) or self.world_frame == self.map_frame:
-            from aiorobot.tf import Buffer, TransformBroadcaster, TransformListener
+        # a tf listener only where transforms are read: IMUs in their own frame, map -> odom
+        if any(kind == "imu" for _, kind in input_names(given)) or self.world_frame == self.map_frame:
+            from aiorobot.tf import Buffer, TransformListener
 
             self._tf_buffer = Buffer()
             self._tf_listener = TransformListener(self._tf_buffer, self)
-            if self.publish_tf:
-                self._tf = TransformBroadcaster(self)
+        if self.publish_tf:
+            from aiorobot.tf import TransformBroadcaster
+
+            self._tf = TransformBroadcaster(self)
         for input_name, kind in input_names(given):
             self._add_input(input_name, kind)
         self._wire_services()
