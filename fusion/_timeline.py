@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from ._ekf import STATE_SIZE, Correction, Ekf, force_two_d
+from ._ekf import Correction, Ekf, force_two_d
 
 __all__ = ["Measurement", "FilterTimeline"]
 
