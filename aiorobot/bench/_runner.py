@@ -27,6 +27,7 @@ PARTS: dict[str, str] = {
     "nav": "aiorobot.bench._nav",
     "sim": "aiorobot.bench._sim",
     "zenoh": "aiorobot.bench._zenoh",
+    "fusion": "aiorobot.bench._fusion",
 }
 
 
