@@ -9,17 +9,28 @@ happen on first use.
 from __future__ import annotations
 
 from ._aruco import MarkerPose, detect_markers, marker_object_points
+from ._blobs import Blob, detect_blobs
+from ._cloud import cloud_to_xyz, voxel_downsample, xyz_to_cloud
 from ._images import ENCODINGS, BadInput, camera_matrix_from_info, image_array
 from ._render import pinhole_matrix, render_markers
+from ._scan import extract_obstacles, scan_to_points, segment_scan
 
 __all__ = [
     "ENCODINGS",
     "BadInput",
+    "Blob",
     "MarkerPose",
     "camera_matrix_from_info",
+    "cloud_to_xyz",
+    "detect_blobs",
     "detect_markers",
+    "extract_obstacles",
     "image_array",
     "marker_object_points",
     "pinhole_matrix",
     "render_markers",
+    "scan_to_points",
+    "segment_scan",
+    "voxel_downsample",
+    "xyz_to_cloud",
 ]
