@@ -12,14 +12,24 @@ from ._aruco import MarkerPose, detect_markers, marker_object_points
 from ._blobs import Blob, detect_blobs
 from ._cloud import cloud_to_xyz, voxel_downsample, xyz_to_cloud
 from ._images import ENCODINGS, BadInput, camera_matrix_from_info, image_array
+from ._pipeline import POLICIES, Pipeline, PipelineStatistics, StageLatency
 from ._render import pinhole_matrix, render_markers
+from ._ring import FrameRing, RingAttachment
 from ._scan import extract_obstacles, scan_to_points, segment_scan
+from ._worker import Frame
 
 __all__ = [
     "ENCODINGS",
+    "POLICIES",
     "BadInput",
     "Blob",
+    "Frame",
+    "FrameRing",
     "MarkerPose",
+    "Pipeline",
+    "PipelineStatistics",
+    "RingAttachment",
+    "StageLatency",
     "camera_matrix_from_info",
     "cloud_to_xyz",
     "detect_blobs",
