@@ -289,8 +289,11 @@ class Pipeline:
                 job_id = self._next_job
                 self._next_job += 1
                 worker.job = (job_id, slot, frame, arrival, time.monotonic())
-                try:
-                    worker.conn.send((job_id, slot, shape, dtype, frame))
+                header = frame.header
+                stamp = None if header is None else (header.stamp.sec, header.stamp.nanosec)
+                try:  # plain values: pickling the Header message would cost more than the frame's copy
+                    worker.conn.send((job_id, slot, shape, dtype, stamp, getattr(header, "frame_id", ""),
+                                      frame.encoding, frame.context))
                 except OSError:
                     self._on_exit(worker)
 
@@ -367,6 +370,11 @@ class Pipeline:
         self._dispatch()
 
     # -- statistics ---------------------------------------------------------------------------
+
+    def reset_statistics(self) -> None:
+        """Forget the latency samples (e.g. after a warm-up); the counters keep counting."""
+        for samples in self._samples.values():
+            samples.clear()
 
     def statistics(self) -> PipelineStatistics:
         latency = {}

@@ -28,8 +28,18 @@ class Frame:
     context: Any
 
 
+def _header(stamp: tuple[int, int] | None, frame_id: str) -> Any:
+    if stamp is None:
+        return None
+    from aiorobot.msgs.std_msgs import Header
+
+    header = Header(frame_id=frame_id)
+    header.stamp.sec, header.stamp.nanosec = stamp
+    return header
+
+
 def worker_main(conn: Any, ring_name: str, slot_bytes: int, kernel: Callable[..., Any]) -> None:
-    """Serve jobs ``(job, slot, shape, dtype, frame)`` until the pipe closes or ``None`` arrives.
+    """Serve jobs ``(job, slot, shape, dtype, stamp, frame_id, encoding, context)`` until the pipe closes or ``None`` arrives.
 
     Replies ``(job, status, result, t_start, t_end)``; ``status`` is ``"ok"``,
     ``"bad"`` (the kernel raised :class:`BadInput`) or ``"error"`` (any other
@@ -45,7 +55,8 @@ def worker_main(conn: Any, ring_name: str, slot_bytes: int, kernel: Callable[...
                 break
             if job is None:
                 break
-            job_id, slot, shape, dtype, frame = job
+            job_id, slot, shape, dtype, stamp, frame_id, encoding, context = job
+            frame = Frame(_header(stamp, frame_id), encoding, context)
             start = time.monotonic()
             pixels = ring.view(slot, shape, dtype)
             try:

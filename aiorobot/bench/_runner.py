@@ -23,6 +23,7 @@ PARTS: dict[str, str] = {
     "latency": "aiorobot.bench._latency",
     "cpu": "aiorobot.bench._cpu",
     "tf": "aiorobot.bench.tf",
+    "perception": "aiorobot.bench._perception",
 }
 
 
