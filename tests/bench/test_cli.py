@@ -95,7 +95,7 @@ def test_only_and_repeat_run_the_chosen_part_and_keep_each_repeat(tmp_path: Path
     [
         (["--repeat", "0"], "expected a whole number >= 1, found '0'"),
         (["--periods", "many"], "expected a whole number >= 1, found 'many'"),
-        (["--only", "gpu"], "expected one of seed, timer, latency, cpu, tf (comma-separated), found 'gpu'"),
+        (["--only", "gpu"], f"expected one of {', '.join(PARTS)} (comma-separated), found 'gpu'"),
         (["--only", "timer", "--plot", "x.png"], "--plot draws the seed part's control periods"),
         (["--json", "no/such/folder/x.json"], "--json no/such/folder/x.json: the folder"),
         (["--frobnicate"], "unrecognized arguments: --frobnicate"),
