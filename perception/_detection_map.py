@@ -99,7 +99,12 @@ class DetectionMapNode(Node):
         camera = np.array([[d.pose.position.x, d.pose.position.y, d.pose.position.z] for d in msg.detections])
         in_map = await self._to_map(msg.header, camera)
         if in_map is not None:
+            new = [i for i in ids if i not in self.state.markers]
             self.state.add_markers(ids, in_map)
+            for marker_id in new:
+                x, y, z = self.state.markers[marker_id].position
+                self.get_logger().info(f"detection map: marker {marker_id} at ({x:.2f}, {y:.2f}, {z:.2f}) "
+                                       f"in {self.map_frame}")
             self._publish(msg.header.stamp)
 
     async def on_obstacles(self, msg: Any) -> None:

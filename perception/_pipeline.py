@@ -240,6 +240,8 @@ class Pipeline:
     # -- frames in ----------------------------------------------------------------------------
 
     def _on_message(self, msg: Any) -> None:
+        if self._closed.is_set():  # frames still queued on the subscription while the node stops
+            return
         arrival = time.monotonic()
         self._counts["received"] += 1
         try:

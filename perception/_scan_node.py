@@ -53,6 +53,8 @@ class ScanObstacleNode(Node):
     async def on_scan(self, msg: Any) -> None:
         from aiorobot.msgs.geometry_msgs import Pose, PoseArray
 
+        if self.runtime.is_shutdown:  # scans still queued while the runtime closes: the thread pool is gone
+            return
         try:
             points, obstacles = await self.run_in_thread(scan_obstacles, msg, self.break_distance, self.min_points)
         except BadInput as exc:
