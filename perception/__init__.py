@@ -16,7 +16,7 @@ from ._detection_map import DetectionMap, DetectionMapNode, MapMarker
 from ._images import ENCODINGS, BadInput, camera_matrix_from_info, image_array
 from ._msgs import MarkerDetection, MarkerDetectionArray
 from ._pipeline import POLICIES, Pipeline, PipelineStatistics, StageLatency
-from ._render import pinhole_matrix, render_markers
+from ._render import draw_markers, pinhole_matrix, render_markers
 from ._ring import FrameRing, RingAttachment
 from ._scan import extract_obstacles, scan_to_points, segment_scan
 from ._scan_node import ScanObstacleNode, scan_obstacles
@@ -48,6 +48,7 @@ __all__ = [
     "cloud_to_xyz",
     "declare_pipeline_parameters",
     "detect_blobs",
+    "draw_markers",
     "detect_markers",
     "extract_obstacles",
     "image_array",

@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from ._aruco import marker_object_points
 
-__all__ = ["pinhole_matrix", "render_markers"]
+__all__ = ["draw_markers", "pinhole_matrix", "render_markers"]
 
 
 def pinhole_matrix(fx: float = 500.0, fy: float = 500.0, cx: float = 320.0, cy: float = 240.0) -> NDArray[np.float64]:
@@ -52,3 +52,22 @@ def render_markers(
         mask = cv2.warpPerspective(np.ones_like(tile), homography, (width, height), flags=cv2.INTER_NEAREST)
         frame[mask > 0] = warped[mask > 0]
     return np.ascontiguousarray(np.repeat(frame[:, :, None], 3, axis=2))
+
+
+def draw_markers(
+    image: NDArray[np.uint8],
+    markers: Sequence[object],
+    camera_matrix: NDArray[np.float64],
+    marker_length: float,
+) -> NDArray[np.uint8]:
+    """A copy of an RGB ``image`` with each :class:`MarkerPose`'s outline, id and pose axes drawn."""
+    import cv2
+
+    out = np.ascontiguousarray(image.copy())
+    for marker in markers:
+        corners = np.asarray(marker.corners, np.float32).reshape(1, 4, 2)  # type: ignore[attr-defined]
+        cv2.aruco.drawDetectedMarkers(out, [corners], np.array([[marker.marker_id]]),  # type: ignore[attr-defined]
+                                      borderColor=(0, 255, 0))
+        cv2.drawFrameAxes(out, camera_matrix, np.zeros(5), marker.rvec, marker.tvec,  # type: ignore[attr-defined]
+                          marker_length / 2, 3)
+    return out

@@ -71,3 +71,15 @@ def test_orientation_is_recovered():
 
 def test_no_markers_gives_an_empty_list():
     assert detect_markers(np.full((480, 640, 3), 128, np.uint8), K, None, 0.5) == []
+
+
+def test_draw_markers_outlines_each_marker_in_green_and_leaves_the_input_alone():
+    from aiorobot.perception import draw_markers
+
+    frame = render_markers([(5, 0.5, FACING, np.array([0.0, 0.0, 2.0]))], K)
+    found = detect_markers(frame, K, None, 0.5)
+    drawn = draw_markers(frame, found, K, 0.5)
+    assert not np.array_equal(drawn, frame) and np.all(frame[:, :, 0] == frame[:, :, 1])
+    x, y = found[0].corners[0].round().astype(int)
+    patch = drawn[y - 2:y + 3, x - 2:x + 3].reshape(-1, 3)
+    assert any((p == (0, 255, 0)).all() for p in patch)
