@@ -39,6 +39,7 @@ POLICIES = ("latest", "drop_oldest")
 STAGES = ("handoff", "to_worker", "kernel", "from_worker", "total", "stamp_to_publish")
 _WARN_EVERY_SEC = 5.0
 _SAMPLES = 4096
+_MAX_START_FAILURES = 3
 
 
 @dataclass(frozen=True)
@@ -74,12 +75,13 @@ class PipelineStatistics:
 
 
 class _Worker:
-    __slots__ = ("index", "process", "conn", "job", "dead")
+    __slots__ = ("index", "process", "conn", "job", "dead", "served")
 
     def __init__(self, index: int, process: Any, conn: Any) -> None:
         self.index, self.process, self.conn = index, process, conn
         self.job: tuple[int, int, Frame, float, float] | None = None  # id, slot, frame, arrival, dispatch
         self.dead = False
+        self.served = 0
 
 
 def _context() -> Any:
@@ -148,6 +150,7 @@ class Pipeline:
         self._supervisor: asyncio.Task[Any] | None = None
         self._ready: asyncio.Event | None = None
         self._next_job = 0
+        self._start_failures = 0
         self._counts = dict.fromkeys(
             ("received", "processed", "published", "dropped_queue", "dropped_bad_input", "failed", "worker_restarts"),
             0)
@@ -316,6 +319,7 @@ class Pipeline:
         if job is None or job[0] != job_id:
             return
         worker.job = None
+        worker.served += 1
         _, slot, frame, arrival, _ = job
         assert self._ring is not None
         self._ring.release(slot)
@@ -361,6 +365,14 @@ class Pipeline:
         worker.conn.close()
         worker.process.close()
         if worker not in self._workers:
+            return
+        self._start_failures = 0 if worker.served or worker.job is not None else self._start_failures + 1
+        if self._start_failures >= _MAX_START_FAILURES:
+            self._workers.remove(worker)
+            self.node.get_logger().error(
+                f"pipeline {self.topic}: worker {worker.index} exited with code {code} before serving a frame, "
+                f"{self._start_failures} times in a row; not restarting it (is the kernel importable? a script "
+                f"needs the `if __name__ == \"__main__\":` guard)")
             return
         self._counts["worker_restarts"] += 1
         self.node.get_logger().warning(

@@ -117,7 +117,7 @@ async def _aruco_fps(frames: int, pixels: np.ndarray) -> dict[str, Any]:
     result: dict[str, Any] = {"frames": frames, "markers_found": len(found), "inline_fps": inline}
     for workers in (1, 2):
         async with Runtime(handle_signals=False) as rt:
-            aruco = ArucoNode(parameter_overrides={"workers": workers, "queue": frames, "policy": "drop_oldest",
+            aruco = ArucoNode(parameter_overrides={"workers": workers, "queue": 1, "policy": "drop_oldest",
                                                    "marker_length": 0.4})
             rt.add_node(aruco)
             from aiorobot import Node
@@ -131,15 +131,18 @@ async def _aruco_fps(frames: int, pixels: np.ndarray) -> dict[str, Any]:
             await _wait(lambda: aruco._camera is not None)
             for _ in range(2 * workers):  # warm-up: imports and the detector in every worker
                 image_pub.publish(_image(pixels, cam))
-            await _wait(lambda: aruco.pipeline.statistics().processed >= 2 * workers)
-            done = aruco.pipeline.statistics().processed
+            await _wait(lambda: aruco.pipeline.statistics().received >= 2 * workers
+                        and aruco.pipeline.statistics().in_flight == 0)
+            stats = aruco.pipeline.statistics
+            done, received = stats().processed, stats().received
             t0 = time.perf_counter()
-            for _ in range(frames):
+            for sent in range(1, frames + 1):  # keep every worker busy and one frame waiting, drop none
                 image_pub.publish(_image(pixels, cam))
-            await _wait(lambda: aruco.pipeline.statistics().processed + aruco.pipeline.statistics().dropped_queue
-                        >= done + frames)
+                await _wait(lambda: (received + sent - stats().received) + stats().in_flight <= workers)
+            await _wait(lambda: stats().processed >= done + frames)
             elapsed = time.perf_counter() - t0
-            result[f"workers_{workers}_fps"] = (aruco.pipeline.statistics().processed - done) / elapsed
+            result[f"workers_{workers}_fps"] = (stats().processed - done) / elapsed
+            result[f"workers_{workers}_kernel_p50_ms"] = stats().latency["kernel"].p50_ms
     return result
 
 

@@ -52,3 +52,17 @@ def gated(pixels, frame):
     while frame.context and not os.path.exists(frame.context):
         time.sleep(0.005)
     return String(data=str(int(np.asarray(pixels).flat[0])))
+
+
+class Unimportable:
+    """A kernel whose class cannot be found by the workers: each one exits at start."""
+
+    def __call__(self, pixels, frame):
+        return None
+
+    def __reduce__(self):
+        return (_missing_in_workers, ())
+
+
+def _missing_in_workers():
+    raise ImportError("this kernel cannot be rebuilt in a worker")

@@ -163,3 +163,14 @@ async def test_back_pressure_policies(tmp_path, policy, expected):
 async def test_bad_settings_are_refused(kw, message):
     with pytest.raises(ValueError, match=message):
         Pipeline(Node("vision"), "/image", Image, kernels.first_pixel, **kw)
+
+
+async def test_a_worker_that_cannot_start_is_not_restarted_in_a_loop(caplog):
+    before = segments()
+    async with Runtime() as rt:
+        node = rt.add_node(Node("vision"))
+        pipeline = Pipeline(node, "/image", Image, kernels.Unimportable(), publish=("/out", String))
+        await pipeline.start()
+        await wait_until(lambda: any("not restarting it" in r.getMessage() for r in caplog.records))
+        assert pipeline.statistics().worker_restarts == 2 and pipeline.worker_pids() == []
+    assert segments() == before
