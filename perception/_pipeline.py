@@ -237,6 +237,11 @@ class Pipeline:
         return [w.process.pid for w in self._workers]
 
     @property
+    def ring_name(self) -> str | None:
+        """The shared-memory segment's name (``/dev/shm/<name>``), once started."""
+        return None if self._ring is None else self._ring.name
+
+    @property
     def free_slots(self) -> int:
         return 0 if self._ring is None else self._ring.free_slots
 

@@ -183,9 +183,9 @@ async def _seed(periods: int, pixels: np.ndarray) -> dict[str, Any]:
         rt.add_node(Control(), executor="priority")
         await finished.wait()
         stats = aruco.pipeline.statistics()
-        del stamps[periods + warmup + 1:]  # ticks that came while the runtime closed
-        elapsed = stamps[-1] - stamps[0]
-    control = period_stats(periods_from_stamps(stamps, warmup), 20.0)
+        taken = stamps[:periods + warmup + 1]  # not the ticks that come while the runtime closes
+        elapsed = taken[-1] - taken[0]
+    control = period_stats(periods_from_stamps(taken, warmup), 20.0)
     latency = stats.latency.get("stamp_to_publish")
     return {
         "periods": control.samples,
