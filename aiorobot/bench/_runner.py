@@ -28,6 +28,7 @@ PARTS: dict[str, str] = {
     "sim": "aiorobot.bench._sim",
     "zenoh": "aiorobot.bench._zenoh",
     "fusion": "aiorobot.bench._fusion",
+    "perception": "aiorobot.bench._perception",
 }
 
 
