@@ -71,7 +71,6 @@ _EXPORTS = {
     "ServerGoalHandle": "_actions",
     "Service": "_services",
     "ServiceError": "_errors",
-    "ShutdownTimeoutError": "_errors",
     "ServiceInfo": "_graph",
     "ServiceUnavailableError": "_services",
     "SetParametersResult": "_parameters",
@@ -144,7 +143,6 @@ __all__ = [
     "ServerGoalHandle",
     "Service",
     "ServiceError",
-    "ShutdownTimeoutError",
     "ServiceInfo",
     "ServiceUnavailableError",
     "SetParametersResult",
@@ -169,7 +167,7 @@ if TYPE_CHECKING:
     from ._clock_publisher import ClockPublisher
     from ._config import ConfigError, GraphConfig, load_config
     from ._errors import InvalidParameterTypeError, ParameterImmutableError, ParameterUninitializedError
-    from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError, ShutdownTimeoutError
+    from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
     from ._future import Future
     from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
     from ._node_graph import NodeNameNonExistentError

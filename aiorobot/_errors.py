@@ -13,7 +13,6 @@ __all__ = [
     "ParameterUninitializedError",
     "QoSIncompatibleError",
     "ServiceError",
-    "ShutdownTimeoutError",
 ]
 
 
@@ -83,7 +82,3 @@ class ParameterUninitializedError(ParameterError):
 
 class ServiceError(RuntimeError):
     """A service call failed on the server side; the message carries the server's reason."""
-
-
-class ShutdownTimeoutError(RuntimeError):
-    """A runtime's shutdown had to abandon a thread that a blocked callback held (the message names it)."""

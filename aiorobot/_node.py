@@ -489,11 +489,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             service._start()
         self._create_task(self._run_hook(self.on_start, "on_start"), name=f"on_start {self._fqn}")
 
-    async def _run_hook(self, hook: Callable[[], Any], what: str, *, name: str | None = None) -> None:
-        if name is not None:  # the task's name is what a loop-stall report shows
-            task = asyncio.current_task()
-            if task is not None:
-                task.set_name(name)
+    async def _run_hook(self, hook: Callable[[], Any], what: str) -> None:
         try:
             result = hook()
             if inspect.isawaitable(result):

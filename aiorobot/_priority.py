@@ -115,16 +115,8 @@ class PriorityLoop:
         assert self.loop is not None
         return await asyncio.wrap_future(asyncio.run_coroutine_threadsafe(coro, self.loop))
 
-    def stop(self, timeout_sec: float | None = None) -> bool:
-        """Stop the loop and join its thread for up to ``timeout_sec``; False when a blocked
-        callback kept it running (the daemon thread is then abandoned)."""
-        stopped = True
+    def stop(self) -> None:
         if self.loop is not None and self._thread is not None and self._thread.is_alive():
-            try:
-                self.loop.call_soon_threadsafe(self.loop.stop)
-            except RuntimeError:  # pragma: no cover - closed meanwhile
-                pass
-            self._thread.join(timeout_sec)
-            stopped = not self._thread.is_alive()
+            self.loop.call_soon_threadsafe(self.loop.stop)
+            self._thread.join()
         self._thread = None
-        return stopped

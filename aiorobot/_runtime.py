@@ -12,7 +12,7 @@ from collections.abc import Coroutine
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ._bus import Bus, Incompatibility
-from ._errors import QoSIncompatibleError, ShutdownTimeoutError
+from ._errors import QoSIncompatibleError
 from ._clock import Clock
 from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._node import Node
@@ -22,7 +22,6 @@ from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
 from ._transport import Transport, make_transport
 from ._waker import LoopWaker, TimerFdWaker, make_waker
-from ._watchdog import LoopWatchdog
 
 if TYPE_CHECKING:
     import concurrent.futures
@@ -66,13 +65,6 @@ class Runtime:
 
     handle_signals
         While ``spin`` runs, SIGINT and SIGTERM shut the runtime down cleanly.
-    shutdown_timeout
-        Seconds the orderly shutdown may take after SIGINT/SIGTERM (on_shutdown hooks, zero
-        commands). Past it, or on a second signal, blocked threads are abandoned and the process
-        exits with status 1 and a message naming what was still blocked.
-    stall_threshold_sec, priority_stall_threshold_sec
-        A callback holding the main (priority) loop longer than this is reported once, with its
-        task and the stack where it blocks, and counted (:meth:`stall_statistics`).
     debug_messages
         Check the zero-copy contract: log an error when a publisher changes a message after
         publishing it, or a subscription callback changes the message it received
@@ -92,9 +84,6 @@ class Runtime:
         priority_realtime: bool = False,
         handle_signals: bool = True,
         debug_messages: bool = False,
-        shutdown_timeout: float = 2.0,
-        stall_threshold_sec: float = 0.5,
-        priority_stall_threshold_sec: float = 0.05,
     ) -> None:
         self._config = config
         if config is not None:
@@ -138,16 +127,6 @@ class Runtime:
         self._clock_tap: Tap | None = None
         self._saved_switch_interval: float | None = None
         self._state = "new"  # new -> running -> closing -> closed
-        for name, value in (("shutdown_timeout", shutdown_timeout), ("stall_threshold_sec", stall_threshold_sec),
-                            ("priority_stall_threshold_sec", priority_stall_threshold_sec)):
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-                raise ValueError(f"{name}: expected a number of seconds > 0, found {value!r}")
-        self.shutdown_timeout = float(shutdown_timeout)
-        self._stall_thresholds = {"main": float(stall_threshold_sec), "priority": float(priority_stall_threshold_sec)}
-        self._watchdog: LoopWatchdog | None = None
-        self._saved_handlers: dict[int, Any] = {}
-        self._signals_seen = 0
-        self.abandoned: list[str] = []  # what a shutdown had to leave blocked
 
     def __repr__(self) -> str:
         return (
@@ -171,23 +150,15 @@ class Runtime:
     async def __aenter__(self) -> Runtime:
         if self._state != "new":
             raise RuntimeError(f"{self!r} cannot be entered twice")
-        self._loop = asyncio.get_running_loop()
-        self._thread_id = threading.get_ident()
-        self._shutdown_event = asyncio.Event()
-        # The watchdog and the signal handlers first: a node constructor that blocks is stoppable too.
-        self._watchdog = LoopWatchdog()
-        self._install_signal_handlers()
         built: list[tuple[Node, str]] = []
         if self._config is not None:
             from ._config import build_nodes
 
-            try:
-                built = build_nodes(self._config)  # validate everything before anything starts
-            except BaseException:
-                self._watchdog.close()
-                self._restore_signal_handlers()
-                raise
+            built = build_nodes(self._config)  # validate everything before anything starts
+        self._loop = asyncio.get_running_loop()
+        self._thread_id = threading.get_ident()
         self._waker = make_waker(self._loop, precise=True)
+        self._shutdown_event = asyncio.Event()
         await self.transport.open(self._bus)
         if self.use_sim_time:
             from .msgs.rosgraph_msgs import Clock as ClockMsg
@@ -207,17 +178,10 @@ class Runtime:
             await self._close()
             raise
         self._pending.clear()
-        # Watch the main loop from here on: imports and constructors above block it by design.
-        self._watchdog.watch("main", self._loop, self._thread_id, self._stall_thresholds["main"])
         return self
 
-    async def __aexit__(self, exc_type: Any, *exc: object) -> None:
+    async def __aexit__(self, *exc: object) -> None:
         await self._close()
-        if self.abandoned and exc_type is None:
-            raise ShutdownTimeoutError(
-                f"shutdown left blocked threads behind: {'; '.join(self.abandoned)}. A callback blocks its loop: "
-                "make it async, or move the work to run_in_thread/offload"
-            )
 
     def _on_clock(self, msg: Any) -> None:
         self.clock.set_sim_time(int(msg.clock.sec) * 1_000_000_000 + int(msg.clock.nanosec))
@@ -327,8 +291,6 @@ class Runtime:
             prio = PriorityLoop(realtime=self._priority_realtime)
             prio.start()
             self._priority = prio
-            if self._watchdog is not None and prio.loop is not None and prio.thread_id is not None:
-                self._watchdog.watch("priority", prio.loop, prio.thread_id, self._stall_thresholds["priority"])
             self._saved_switch_interval = sys.getswitchinterval()
             sys.setswitchinterval(min(self._saved_switch_interval, PRIORITY_SWITCH_INTERVAL_SEC))
         return self._priority
@@ -345,64 +307,36 @@ class Runtime:
             raise RuntimeError(f"spin needs an entered runtime: use `async with Runtime() as rt` ({self!r})")
         if duration_sec is not None and (isinstance(duration_sec, bool) or not duration_sec >= 0):
             raise ValueError(f"spin duration_sec: expected a number >= 0 or None, got {duration_sec!r}")
-        self._install_signal_handlers()
-        if duration_sec is None:
-            await self._shutdown_event.wait()
-        else:
-            try:
-                await asyncio.wait_for(self._shutdown_event.wait(), duration_sec)
-            except TimeoutError:
-                pass
+        installed = self._install_signal_handlers()
+        try:
+            if duration_sec is None:
+                await self._shutdown_event.wait()
+            else:
+                try:
+                    await asyncio.wait_for(self._shutdown_event.wait(), duration_sec)
+                except TimeoutError:
+                    pass
+        finally:
+            for sig in installed:
+                assert self._loop is not None
+                self._loop.remove_signal_handler(sig)
 
-    def _install_signal_handlers(self) -> None:
-        """SIGINT/SIGTERM handlers that work while a callback blocks the loop.
-
-        Python-level handlers (not the loop's): they run in the main thread between two
-        bytecodes even when a callback there sleeps, so the emergency stops and the shutdown
-        deadline never wait for the loop. They stay until the shutdown is over.
-        """
-        if self._saved_handlers or not self._handle_signals or threading.current_thread() is not threading.main_thread():
-            return
+    def _install_signal_handlers(self) -> list[signal.Signals]:
+        if not self._handle_signals or threading.current_thread() is not threading.main_thread():
+            return []
+        installed = []
+        assert self._loop is not None
         for sig in (signal.SIGINT, signal.SIGTERM):
             try:
-                self._saved_handlers[sig] = signal.signal(sig, self._on_signal)
-            except (ValueError, OSError):  # pragma: no cover - not the main interpreter
+                self._loop.add_signal_handler(sig, self._on_signal, sig)
+                installed.append(sig)
+            except (NotImplementedError, RuntimeError, ValueError):
                 pass
+        return installed
 
-    def _restore_signal_handlers(self) -> None:
-        for sig, handler in self._saved_handlers.items():
-            try:
-                signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
-            except (ValueError, OSError):  # pragma: no cover
-                pass
-        self._saved_handlers.clear()
-
-    def _on_signal(self, sig: int, _frame: Any = None) -> None:
-        self._signals_seen += 1
-        name = signal.Signals(sig).name
-        watchdog = self._watchdog
-        if self._signals_seen > 1 and watchdog is not None:
-            watchdog.force_exit(f"{name} received again")
-        # Straight to stderr, whatever logging is configured: the person pressing Ctrl-C must see it.
-        sys.stderr.write(f"aiorobot: {name} received: shutting down (within {self.shutdown_timeout:g} s; again to force)\n")
-        sys.stderr.flush()
-        if watchdog is not None:
-            threading.Thread(target=watchdog.emergency_stop, name="aiorobot-emergency-stop", daemon=True).start()
-            watchdog.arm_deadline(self.shutdown_timeout)
+    def _on_signal(self, sig: int) -> None:
+        _log.info(f"{signal.Signals(sig).name} received: shutting down")
         self.shutdown()
-
-    def add_emergency_stop(self, fn: Any) -> Any:
-        """Run ``fn()`` first thing on shutdown (signal or end of run) in a thread of its own, which no
-        callback can block: base controllers send their zero command this way. Returns the remover."""
-        if self._watchdog is None:
-            raise RuntimeError(f"add_emergency_stop needs an entered runtime ({self!r})")
-        return self._watchdog.add_emergency_stop(fn)
-
-    def stall_statistics(self) -> Any:
-        """Loop stalls counted so far (``StallStatistics``: counts per loop, the reports)."""
-        from ._watchdog import StallStatistics
-
-        return self._watchdog.statistics() if self._watchdog is not None else StallStatistics()
 
     def shutdown(self) -> None:
         """Ask ``spin`` to return (from any thread). ``async with`` then stops everything."""
@@ -432,24 +366,18 @@ class Runtime:
         if self._state in ("closing", "closed"):
             return
         self._state = "closing"
-        if self._watchdog is not None and self._signals_seen == 0:  # (a signal already started them)
-            threading.Thread(target=self._watchdog.emergency_stop, name="aiorobot-emergency-stop", daemon=True).start()
-        hook_timeout = min(SHUTDOWN_HOOK_TIMEOUT_SEC, self.shutdown_timeout / 2)
         nodes = list(self._nodes)
         # 1. on_shutdown hooks, each on its node's loop (controllers send their last command here).
         if nodes:
             # Scheduled after each node's _start on the same loop, so every hook sees a started node.
-            hooks = [
-                asyncio.ensure_future(self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown", name=f"on_shutdown of {n.get_fully_qualified_name()}")))
-                for n in nodes
-            ]
+            hooks = [self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown")) for n in nodes]
             done, pending = await asyncio.wait(
-                hooks or [asyncio.ensure_future(asyncio.sleep(0))],
-                timeout=hook_timeout,
+                [asyncio.ensure_future(h) for h in hooks] or [asyncio.ensure_future(asyncio.sleep(0))],
+                timeout=SHUTDOWN_HOOK_TIMEOUT_SEC,
             )
             for task in pending:
                 task.cancel()
-                _log.warning(f"an on_shutdown hook did not finish within {hook_timeout:g} s and was cancelled")
+                _log.warning("an on_shutdown hook did not finish in time and was cancelled")
             if pending:
                 await asyncio.gather(*pending, return_exceptions=True)
             # 2. Let what the hooks published reach its subscribers.
@@ -469,13 +397,7 @@ class Runtime:
             self._clock_tap = None
         # 4. Loops, transport, pools.
         if self._priority is not None:
-            if self._watchdog is not None:
-                blocked = [b for b in self._watchdog.blocked() if b.loop == "priority"]
-                self._watchdog.unwatch("priority")
-            if not self._priority.stop(timeout_sec=self.shutdown_timeout / 4):
-                what = blocked[0].describe() if blocked else "the priority loop"
-                self.abandoned.append(what)
-                _log.error(f"shutdown: abandoning {what}: it did not stop within {self.shutdown_timeout / 4:g} s")
+            self._priority.stop()
             self._priority = None
             if self._saved_switch_interval is not None:
                 sys.setswitchinterval(self._saved_switch_interval)
@@ -489,9 +411,6 @@ class Runtime:
         if self._waker is not None:
             self._waker.close()
             self._waker = None
-        if self._watchdog is not None:
-            self._watchdog.close()
-        self._restore_signal_handlers()
         self._state = "closed"
 
     async def _flush(self, nodes: list[Node]) -> None:
@@ -583,11 +502,7 @@ def run(main: Coroutine[Any, Any, T], *, debug: bool | None = None) -> T:
     except ImportError:  # pragma: no cover
         return asyncio.run(main, debug=debug)
     with asyncio.Runner(loop_factory=uvloop.new_event_loop, debug=debug) as runner:
-        try:
-            return runner.run(main)
-        except ShutdownTimeoutError as err:
-            sys.stderr.write(f"aiorobot: {err}\n")
-            raise SystemExit(1) from None
+        return runner.run(main)
 
 
 

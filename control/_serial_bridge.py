@@ -84,7 +84,6 @@ class SerialMotorBridge(Node):
         self.firmware_status = FirmwareStatus.HOST_TIMEOUT
         self.firmware_alive = False
         self.estop_active = False  # an e-stop this bridge sent and has not cleared
-        self._emergency_sent = False
         self._estop_by_watchdog = False
         self.wheel_positions_rad: NDArray[np.float64] = np.zeros(len(self.joint_names))
         self.wheel_velocities_rad_s: NDArray[np.float64] = np.zeros(len(self.joint_names))
@@ -116,16 +115,6 @@ class SerialMotorBridge(Node):
         return self.link.statistics()
 
     # -- lifecycle -----------------------------------------------------------------------
-
-    def _bind(self, runtime: Any, *args: Any, **kwargs: Any) -> None:
-        super()._bind(runtime, *args, **kwargs)
-        # Registered when added, before any callback of the loop can block it.
-        self._remove_emergency = runtime.add_emergency_stop(self.emergency_zero)
-
-    def emergency_zero(self) -> None:
-        """Zero the wheels at once from any thread (the runtime's emergency stop at shutdown)."""
-        if self.link.emergency_write(SetWheelVelocities((0.0,) * len(self.joint_names))):
-            self._emergency_sent = True
 
     async def on_start(self) -> None:
         self._try_connect(time.monotonic())

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import asyncio
 import enum
-import os
 import select
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -242,23 +241,6 @@ class SerialLink:
                 self._on_disconnect(exc)
             except Exception:
                 pass
-
-    def emergency_write(self, message: Message) -> bool:
-        """Write ``message`` now, from any thread, bypassing the send queue.
-
-        For the zero command at shutdown when the loop that owns the link may be blocked: a
-        delimiter first (so a frame the loop was half-way through cannot swallow this one; the
-        firmware drops the torn frame on its CRC), then the frame, straight to the file
-        descriptor without waiting. False when the link is down or the write did not go through.
-        """
-        fd = self._fd
-        if not self.connected or fd is None:
-            return False
-        frame = b"\x00" + encode_message(message, 0xFF)
-        try:
-            return os.write(fd, frame) == len(frame)
-        except OSError:
-            return False
 
     def flush_now(self) -> None:
         """Try once more to write what is pending (used right before closing)."""
