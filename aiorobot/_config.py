@@ -55,8 +55,13 @@ _RUNTIME_KEYS = (
     "log_level",
     "priority_realtime",
     "debug_messages",
+    "shutdown_timeout",
+    "stall_threshold",
+    "priority_stall_threshold",
 )
-_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level")
+_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "on_failure")
+#: what a node's failure to start does to the run (``[[nodes]] on_failure``)
+ON_FAILURE = ("stop", "continue", "restart")
 _RECORD_KEYS = ("path",)
 _TOP_KEYS = ("runtime", "nodes", "record")
 
@@ -106,6 +111,9 @@ class RuntimeConfig:
     log_level: str = "info"
     priority_realtime: bool = False
     debug_messages: bool = False
+    shutdown_timeout: float = 2.0
+    stall_threshold: float = 0.5
+    priority_stall_threshold: float = 0.05
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,6 +133,7 @@ class NodeConfig:
     parameters: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     remap: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     log_level: str | None = None
+    on_failure: str = "stop"
 
     @property
     def key(self) -> str:
@@ -243,7 +252,16 @@ def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
     checker.check_type(realtime, "runtime.priority_realtime", bool, "true or false")
     debug_messages = table.get("debug_messages", False)
     checker.check_type(debug_messages, "runtime.debug_messages", bool, "true or false")
-    return RuntimeConfig(transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages)
+    seconds = {}
+    for name, default in (("shutdown_timeout", 2.0), ("stall_threshold", 0.5), ("priority_stall_threshold", 0.05)):
+        value = table.get(name, default)
+        checker.check_type(value, f"runtime.{name}", (int, float), "a number of seconds > 0")
+        if isinstance(value, bool) or not value > 0:
+            raise checker.error(f"runtime.{name}", f"expected a number of seconds > 0, found {value!r}")
+        seconds[name] = float(value)
+    return RuntimeConfig(
+        transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, **seconds
+    )
 
 
 def _parse_nodes(checker: _Checker, data: Mapping[str, Any]) -> tuple[NodeConfig, ...]:
@@ -321,6 +339,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
                 raise checker.error(source_key, f"{which}: {_name_problem(err)}") from None
 
     log_level = checker.choice(table, key, "log_level", LOG_LEVELS, None)
+    on_failure = checker.choice(table, key, "on_failure", ON_FAILURE, "stop")
     return NodeConfig(
         index=index,
         use=use,
@@ -330,6 +349,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
         parameters=MappingProxyType(flat),
         remap=MappingProxyType(dict(remap)),
         log_level=log_level,
+        on_failure=on_failure,
     )
 
 

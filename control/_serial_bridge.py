@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import time
 from typing import Any
 
@@ -24,6 +25,7 @@ from ._messages import (
     SetWheelVelocities,
     VersionRequest,
     VersionResponse,
+    encode_message,
 )
 from ._odometry import tick_delta
 from ._serial_link import SerialLink
@@ -117,9 +119,27 @@ class SerialMotorBridge(Node):
     # -- lifecycle -----------------------------------------------------------------------
 
     async def on_start(self) -> None:
+        self.runtime._add_emergency_stop(self.get_fully_qualified_name(), self._emergency_stop)
         self._try_connect(time.monotonic())
 
+    def _emergency_stop(self) -> None:
+        """On SIGINT/SIGTERM, before anything else: write a zero wheel command to the port.
+
+        Runs in the runtime's watchdog thread and writes straight to the descriptor, so a
+        callback blocking the loop cannot delay it. The leading delimiter ends any frame
+        the loop was half-way through, so the firmware decodes this one.
+        """
+        fd = self.link._fd
+        if fd is None or not self.link.connected:
+            return
+        frame = b"\x00" + encode_message(SetWheelVelocities((0.0,) * len(self.joint_names)), 0)
+        try:
+            os.write(fd, frame)
+        except OSError as err:  # a full or vanished port: the on_shutdown path tries again
+            self.get_logger().warning(f"emergency zero command to {self.port} not written: {err}")
+
     async def on_shutdown(self) -> None:
+        self.runtime._remove_emergency_stop(self._emergency_stop)
         self._shutting_down = True
         if self.link.connected:
             self.link.send(SetWheelVelocities((0.0,) * len(self.joint_names)))
