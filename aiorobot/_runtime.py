@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
+import re
 import signal
 import sys
 import threading
@@ -547,6 +548,8 @@ class Runtime:
             import concurrent.futures
             import multiprocessing
 
+            _check_main_guard()
+
             method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
             self._processes = concurrent.futures.ProcessPoolExecutor(
                 max_workers=self._process_workers or os.cpu_count() or 2,
@@ -600,6 +603,27 @@ class Runtime:
             if s.name.endswith(suffix)
         )
         return Graph(nodes, tuple(topics), tuple(self._bus.incompatibilities()), services, actions)
+
+
+_MAIN_GUARD = re.compile(r"""__name__\s*==\s*['"]__main__['"]""")
+
+
+def _check_main_guard() -> None:
+    """Process workers import the main script: without the guard it would run again in each."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if main is None or path is None or getattr(main, "__spec__", None) is not None:
+        return  # interactive, ``python -m``, or a console script: nothing to re-run
+    try:
+        with open(path, encoding="utf-8") as f:
+            source = f.read()
+    except (OSError, UnicodeDecodeError):
+        return
+    if not _MAIN_GUARD.search(source):
+        raise RuntimeError(
+            f"offload starts worker processes that import {os.path.basename(path)}: put its entry point "
+            f'under `if __name__ == "__main__":` (e.g. `if __name__ == "__main__": aiorobot.run(main())`)'
+        )
 
 
 def run(main: Coroutine[Any, Any, T], *, debug: bool | None = None) -> T:

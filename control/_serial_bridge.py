@@ -229,7 +229,7 @@ class SerialMotorBridge(Node):
     def _on_firmware_heartbeat(self, message: FirmwareHeartbeat) -> None:
         self._last_firmware_heartbeat = time.monotonic()
         if message.status != self.firmware_status:
-            self.get_logger().info(f"firmware status {message.status!r}")
+            self.get_logger().info(f"firmware status {message.status.name or int(message.status)}")
         self.firmware_status = message.status
         if not self.firmware_alive:
             self.firmware_alive = True

@@ -56,7 +56,7 @@ class SimulatedFirmwareNode(Node):
         stats = fw.decoder.statistics()
         return (
             f"{self.get_name()}: {fw.commands_received} wheel commands, {stats.frames_ok} frames from the host "
-            f"({stats.bad_frames} bad), final status {fw.status!r}"
+            f"({stats.bad_frames} bad), final status {fw.status.name or int(fw.status)}"
         )
 
     async def on_shutdown(self) -> None:

@@ -79,6 +79,13 @@ def main(args: argparse.Namespace) -> int:
         config_path: Path = DEFAULT_CONFIG
     else:
         config_path = args.config
+    if config_path.suffix == ".py":
+        print(
+            f"{config_path}: expected a TOML graph file (aiorobot run graph.toml), found a Python file; "
+            f"to run one node class from it, use aiorobot run {config_path.stem}:ClassName",
+            file=sys.stderr,
+        )
+        return EXIT_CONFIG_ERROR
     try:
         config = load_config(config_path)
     except ConfigError as err:

@@ -109,3 +109,47 @@ def test_an_application_that_configures_logging_keeps_its_own_format(tmp_path):
     (tmp_path / "s.py").write_text(SCRIPT)
     result = subprocess.run([sys.executable, "s.py", "configured"], cwd=tmp_path, capture_output=True, text=True, timeout=60)
     assert result.stderr.splitlines() == ["APP WARNING careful"]
+
+
+def test_run_of_a_python_file_says_it_expects_a_toml_graph(tmp_path):
+    (tmp_path / "node.py").write_text("raise SystemExit('must not be imported')\n")
+    result = subprocess.run([AIOROBOT, "run", "node.py"], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [
+        "node.py: expected a TOML graph file (aiorobot run graph.toml), found a Python file; "
+        "to run one node class from it, use aiorobot run node:ClassName"
+    ]
+
+
+OFFLOAD = textwrap.dedent(
+    '''
+    import math
+    import aiorobot
+    from aiorobot import Node, Runtime
+
+    async def main():
+        async with Runtime(process_workers=1) as rt:
+            node = rt.add_node(Node("worker"))
+            print(await node.offload(math.sqrt, 4.0))
+
+    {call}
+    '''
+)
+
+
+def test_offload_from_a_script_without_the_main_guard_says_what_to_add(tmp_path):
+    (tmp_path / "unguarded.py").write_text(OFFLOAD.format(call="aiorobot.run(main())"))
+    result = subprocess.run([sys.executable, "unguarded.py"], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 1
+    assert result.stderr.splitlines()[-1] == (
+        "RuntimeError: offload starts worker processes that import unguarded.py: put its entry point under "
+        '`if __name__ == "__main__":` (e.g. `if __name__ == "__main__": aiorobot.run(main())`)'
+    )
+    assert "bootstrapping" not in result.stderr
+
+
+def test_offload_from_a_guarded_script_works(tmp_path):
+    (tmp_path / "guarded.py").write_text(OFFLOAD.format(call='if __name__ == "__main__":\n    aiorobot.run(main())'))
+    result = subprocess.run([sys.executable, "guarded.py"], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "2.0"

@@ -41,6 +41,7 @@ def test_blocked_node_is_abandoned_after_the_deadline_and_the_wheels_get_zero(tm
     what = "on_shutdown" if block_in == "on_shutdown" else "timer 0.05s"
     assert f"{executor} loop: {what} of /commander blocked at blockers.py" in err, err
     assert "Traceback" not in err
+    assert "firmware status OK" in err and "<FirmwareStatus" not in err  # enums by name
     assert after and after[-1] == (0.0, 0.0, 0.0, 0.0)
 
 
