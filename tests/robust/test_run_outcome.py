@@ -153,3 +153,13 @@ def test_offload_from_a_guarded_script_works(tmp_path):
     result = subprocess.run([sys.executable, "guarded.py"], cwd=tmp_path, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "2.0"
+
+
+def test_square_cmd_vel_example_prints_its_pattern_when_run():
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    result = subprocess.run([sys.executable, "square_cmd_vel.py"], cwd=examples, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert "linear.x=+0.30" in result.stdout
+    assert "aiorobot run examples/mecanum_serial.toml" in result.stdout
