@@ -64,7 +64,9 @@ class SerialMotorBridge(Node):
     def __init__(self, **kw: Any) -> None:
         super().__init__("serial_motor_bridge", **kw)
         p = self.declare_parameter
-        self.port = p("port", "/dev/ttyUSB0", description="serial device path or pyserial URL").value
+        self.port = p(
+            "port", "/dev/ttyUSB0", description="serial device path or pyserial URL; {pid} is this process's id"
+        ).value.replace("{pid}", str(os.getpid()))
         self.baud_rate = p("baud_rate", 115200, description="line speed", range=(1200, 12_000_000)).value
         self.joint_names = [str(n) for n in p("joint_names", list(_DEFAULT_JOINTS), description="wheel joints, firmware order").value]
         self.heartbeat_period_sec = p("heartbeat_period_sec", 0.1, description="host heartbeat period", range=(0.005, 10.0)).value
