@@ -126,3 +126,12 @@ async def test_on_failure_continue_keeps_the_node_running():
         rt.add_node(node)
         await wait_until(lambda: rt.statistics()["failed_starts"] == ["/faulty"] and node.calls >= 5)
         assert not rt.is_shutdown
+
+
+async def test_monitor_before_any_message_says_no_messages_yet():
+    from aiorobot.examples.monitor import RateMonitor
+
+    async with Runtime() as rt:
+        monitor = rt.add_node(RateMonitor())
+        assert "no messages yet" in monitor.status_line() and "nan" not in monitor.status_line()
+        assert "no messages yet" in monitor.summary() and "nan" not in monitor.summary()
