@@ -1,8 +1,9 @@
 """aiorobot: an async-first asyncio robotics framework.
 
 Nodes, topics, QoS, timers, callback groups, parameters, services, actions and
-ROS 2 messages, asyncio-native, with a priority loop for control. See API.md
-for the contract.
+ROS 2 messages, asyncio-native, with a priority loop for control. The public
+API is listed in docs/api.md in the repository; help(aiorobot.Node) and friends
+show each name's documentation.
 
 Public names are imported on first use (PEP 562), so ``import aiorobot.msgs``
 or ``aiorobot --help`` pay only for what they touch.

@@ -60,8 +60,13 @@ _RUNTIME_KEYS = (
     "record",
     "foxglove",
     "zenoh_config",
+    "shutdown_timeout",
+    "stall_threshold",
+    "priority_stall_threshold",
 )
-_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file")
+_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file", "on_failure")
+#: what a node's failure to start does to the run (``[[nodes]] on_failure``)
+ON_FAILURE = ("stop", "continue", "restart")
 _RECORD_KEYS = ("path", "topics", "exclude", "compression", "max_bag_size", "max_bag_duration", "max_cache_size")
 _FOXGLOVE_KEYS = ("host", "port", "max_large_hz")
 _TOP_KEYS = ("runtime", "nodes", "record")
@@ -114,6 +119,9 @@ class RuntimeConfig:
     debug_messages: bool = False
     parameters_file: str | None = None  # a ROS 2 YAML parameter file for every node (absolute path)
     zenoh_config: str | None = None  # a zenoh session config file (JSON5) for routers, TLS, access control
+    shutdown_timeout: float = 2.0
+    stall_threshold: float = 0.5
+    priority_stall_threshold: float = 0.05
 
 
 @dataclass(frozen=True, slots=True)
@@ -134,6 +142,7 @@ class NodeConfig:
     remap: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     log_level: str | None = None
     parameters_file: str | None = None  # this node's ROS 2 YAML parameter file (absolute path)
+    on_failure: str = "stop"
 
     @property
     def key(self) -> str:
@@ -284,8 +293,16 @@ def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
         if transport != "zenoh":
             raise checker.error("runtime.zenoh_config", 'only applies with transport = "zenoh"')
         zenoh_config = str(resolved)
+    seconds = {}
+    for name, default in (("shutdown_timeout", 2.0), ("stall_threshold", 0.5), ("priority_stall_threshold", 0.05)):
+        value = table.get(name, default)
+        checker.check_type(value, f"runtime.{name}", (int, float), "a number of seconds > 0")
+        if isinstance(value, bool) or not value > 0:
+            raise checker.error(f"runtime.{name}", f"expected a number of seconds > 0, found {value!r}")
+        seconds[name] = float(value)
     return RuntimeConfig(
-        transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file, zenoh_config
+        transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file, zenoh_config,
+        **seconds
     )
 
 
@@ -364,6 +381,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
                 raise checker.error(source_key, f"{which}: {_name_problem(err)}") from None
 
     log_level = checker.choice(table, key, "log_level", LOG_LEVELS, None)
+    on_failure = checker.choice(table, key, "on_failure", ON_FAILURE, "stop")
     return NodeConfig(
         index=index,
         use=use,
@@ -374,6 +392,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
         remap=MappingProxyType(dict(remap)),
         log_level=log_level,
         parameters_file=_parameters_file(checker, table, key),
+        on_failure=on_failure,
     )
 
 

@@ -190,6 +190,7 @@ def _construct(config: GraphConfig, node_config: NodeConfig) -> Node:
             node_config.key,
             f'constructing "{node_config.use}" failed: {_describe(err)}',
         ) from None
+    _check_kwargs_reached_node(config, node_config, cls, node, kwargs)
     unclaimed = sorted(node.unclaimed_parameter_overrides())
     if unclaimed:
         name = unclaimed[0]
@@ -206,6 +207,33 @@ def _construct(config: GraphConfig, node_config: NodeConfig) -> Node:
     if node_config.log_level is not None:
         node.get_logger().set_level(node_config.log_level)
     return node
+
+
+def _check_kwargs_reached_node(
+    config: GraphConfig, node_config: NodeConfig, cls: type, node: Node, kwargs: dict[str, Any]
+) -> None:
+    """The built node carries the configured name, namespace, overrides and remappings.
+
+    A constructor that accepts ``**kwargs`` but does not pass them on to ``Node.__init__``
+    would otherwise run with none of its configuration.
+    """
+    dropped = []
+    if node_config.name is not None and node.get_name() != node_config.name:
+        dropped.append(f"name {node_config.name!r} (the node is named {node.get_name()!r})")
+    if node_config.namespace is not None and node.get_namespace() != node_config.namespace:
+        dropped.append(f"namespace {node_config.namespace!r} (the node has {node.get_namespace()!r})")
+    overrides = getattr(node._parameters, "overrides", {})
+    if any(name not in overrides for name in kwargs.get("parameter_overrides", {})):
+        dropped.append("parameters")
+    if any(node._remappings.get(k) != v for k, v in node_config.remap.items()):
+        dropped.append("remap")
+    if dropped:
+        raise ConfigError(
+            config.path,
+            node_config.key,
+            f"{cls.__name__} ignored its configured {', '.join(dropped)}: its constructor must pass "
+            f'**kwargs to Node.__init__ (write "def __init__(self, **kw): super().__init__("name", **kw)")',
+        )
 
 
 def _check_signature(

@@ -3,6 +3,14 @@
 Records go through the standard :mod:`logging` hierarchy under ``aiorobot.node.*``
 (so applications configure handlers as usual); :func:`setup_logging` installs
 the ROS-style format ``[INFO] [1700000000.123456789] [/ns/node]: message``.
+
+As in rclpy, node loggers print INFO and above to stderr in that format by
+default: when the first node logger is made and the application has configured
+no logging (no handler on the root or ``aiorobot`` logger), a default handler is
+put on the ``aiorobot`` logger. It steps aside as soon as the application
+configures logging itself (``logging.basicConfig(...)``, :func:`setup_logging`,
+a handler of its own); ``logging.getLogger("aiorobot").setLevel("WARNING")``
+quietens it, ``node.get_logger().set_level("debug")`` shows more of one node.
 """
 
 from __future__ import annotations
@@ -37,10 +45,47 @@ def parse_level(level: str | int) -> int:
     )
 
 
+class _DefaultHandler(logging.StreamHandler):  # type: ignore[type-arg]
+    """stderr in the node format, for applications that configured no logging of their own."""
+
+    def __init__(self) -> None:
+        super().__init__(sys.stderr)
+        self.setFormatter(NodeFormatter())
+
+    def emit(self, record: logging.LogRecord) -> None:
+        root = logging.getLogger("aiorobot")
+        if logging.root.handlers or any(h is not self for h in root.handlers):
+            return  # the application configured logging after all: its handlers have it
+        self.stream = sys.stderr  # looked up at each record, so redirections apply
+        super().emit(record)
+
+
+_default_handler: _DefaultHandler | None = None
+
+
+def _install_default_handler() -> None:
+    """Give node loggers rclpy's default (INFO+ to stderr) unless logging is configured."""
+    global _default_handler
+    if _default_handler is not None:
+        return
+    logger = logging.getLogger("aiorobot")
+    if logging.root.handlers or logger.handlers:
+        return
+    _default_handler = _DefaultHandler()
+    logger.addHandler(_default_handler)
+    if logger.level == logging.NOTSET:
+        logger.setLevel(logging.INFO)
+
+
 class NodeLogger:
-    """A node's logger, as rclpy's: ``info(msg, throttle_duration_sec=..., once=...)``."""
+    """A node's logger, as rclpy's: ``info(msg, throttle_duration_sec=..., once=...)``.
+
+    Prints INFO and above to stderr by default when the application configured no
+    logging (see the module docstring for how to change it).
+    """
 
     def __init__(self, node_fqn: str, clock: Clock | None = None) -> None:
+        _install_default_handler()
         self.name = node_fqn
         dotted = node_fqn.strip("/").replace("/", ".") or "root"
         self._logger = logging.getLogger(f"aiorobot.node.{dotted}")
@@ -155,6 +200,8 @@ def setup_logging(level: str | int = "info", stream: Any = None) -> logging.Hand
     handler = logging.StreamHandler(stream if stream is not None else sys.stderr)
     handler.setFormatter(NodeFormatter())
     root = logging.getLogger("aiorobot")
+    if _default_handler is not None:
+        root.removeHandler(_default_handler)
     root.addHandler(handler)
     root.setLevel(parse_level(level))
     return handler

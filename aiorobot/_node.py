@@ -37,6 +37,11 @@ if TYPE_CHECKING:
 
 __all__ = ["Node"]
 
+#: how often ``on_start`` is retried under ``on_failure = "restart"``
+START_RETRIES = 3
+#: repeated failures of one callback are logged at most this often (all are counted)
+FAILURE_LOG_PERIOD_SEC = 5.0
+
 M = TypeVar("M")
 R = TypeVar("R")
 
@@ -487,17 +492,54 @@ class Node(NodeParametersMixin, NodeGraphMixin):
                 timer._start()
         for service in self._services:
             service._start()
-        self._create_task(self._run_hook(self.on_start, "on_start"), name=f"on_start {self._fqn}")
+        self._create_task(self._run_on_start(), name=f"on_start {self._fqn}")
 
-    async def _run_hook(self, hook: Callable[[], Any], what: str) -> None:
+    async def _run_on_start(self) -> None:
+        """``on_start``; a failure is reported to the runtime, which applies ``on_failure``.
+
+        ``"stop"`` (the default) stops the run, ``"continue"`` leaves the node's callbacks
+        running, ``"restart"`` runs ``on_start`` again (at most :data:`START_RETRIES` times,
+        one second apart) before reporting the failure.
+        """
+        attempt = 0
+        while True:
+            err = await self._run_hook(self.on_start, "on_start")
+            if err is None:
+                return
+            attempt += 1
+            if getattr(self, "_on_failure", "stop") == "restart" and attempt <= START_RETRIES:
+                self._logger.warning(f"restarting on_start of {self._fqn} (attempt {attempt} of {START_RETRIES})")
+                await asyncio.sleep(1.0)
+                continue
+            runtime = self._runtime
+            if runtime is not None:
+                runtime._record_failed_start(self, err)
+            return
+
+    async def _run_hook(self, hook: Callable[[], Any], what: str) -> BaseException | None:
+        """Run a lifecycle hook; log and return (never raise) what it raises."""
         try:
             result = hook()
             if inspect.isawaitable(result):
                 await result
         except asyncio.CancelledError:
             raise
-        except Exception:
+        except Exception as err:
+            self._report_failure(what, err)
+            return err
+        return None
+
+    def _report_failure(self, what: str, err: BaseException) -> None:
+        """Count a failure; log the first of each entity with its traceback, repeats throttled."""
+        runtime = self._runtime
+        count, log_now = runtime._record_failure(self._fqn, what) if runtime is not None else (1, True)
+        if count == 1:
             self._logger.error(f"{what} of {self._fqn} raised", exc_info=True)
+        elif log_now:
+            self._logger.error(
+                f"{what} of {self._fqn} raised again ({count} times so far; "
+                f"repeats are logged every {FAILURE_LOG_PERIOD_SEC:g} s): {type(err).__name__}: {err}"
+            )
 
     async def _stop(self) -> None:
         """Cancel every task of this node and wait for them (on the node's loop)."""
@@ -573,8 +615,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             return result
         except asyncio.CancelledError:
             raise
-        except Exception:
-            self._logger.error(f"callback of {_describe(entity)} in {self._fqn} raised", exc_info=True)
+        except Exception as err:
+            self._report_failure(f"callback of {_describe(entity)}", err)
             return None
 
 

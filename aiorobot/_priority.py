@@ -115,8 +115,18 @@ class PriorityLoop:
         assert self.loop is not None
         return await asyncio.wrap_future(asyncio.run_coroutine_threadsafe(coro, self.loop))
 
-    def stop(self) -> None:
-        if self.loop is not None and self._thread is not None and self._thread.is_alive():
-            self.loop.call_soon_threadsafe(self.loop.stop)
-            self._thread.join()
+    def stop(self, timeout: float = 2.0) -> bool:
+        """Stop the loop and join its thread for at most ``timeout`` seconds.
+
+        Returns False when a callback still blocks the thread: it is abandoned (a daemon
+        thread; its loop stops and closes if the callback ever returns).
+        """
+        thread = self._thread
+        if self.loop is not None and thread is not None and thread.is_alive():
+            if not self.loop.is_closed():
+                self.loop.call_soon_threadsafe(self.loop.stop)
+            thread.join(timeout)
+            if thread.is_alive():
+                return False
         self._thread = None
+        return True

@@ -5,9 +5,11 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
+import re
 import signal
 import sys
 import threading
+import time
 from collections.abc import Coroutine
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -22,6 +24,7 @@ from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
 from ._transport import Transport, make_transport
 from ._waker import LoopWaker, TimerFdWaker, make_waker
+from ._watchdog import Watchdog
 
 if TYPE_CHECKING:
     import concurrent.futures
@@ -37,8 +40,11 @@ EXECUTORS = ("main", "priority")
 #: lateness measured with 200 us (p50 324 -> 183 us, p99 710 -> 377 us) at no extra CPU.
 PRIORITY_SWITCH_INTERVAL_SEC = 0.00005
 #: Bounds for the shutdown sequence.
-SHUTDOWN_HOOK_TIMEOUT_SEC = 5.0
+SHUTDOWN_TIMEOUT_SEC = 2.0
 FLUSH_TIMEOUT_SEC = 1.0
+#: How long a callback may hold a loop before the watchdog reports a stall.
+STALL_THRESHOLD_SEC = 0.5
+PRIORITY_STALL_THRESHOLD_SEC = 0.05
 
 
 class Runtime:
@@ -69,6 +75,13 @@ class Runtime:
         Check the zero-copy contract: log an error when a publisher changes a message after
         publishing it, or a subscription callback changes the message it received
         (development aid; it pickles every message).
+    shutdown_timeout
+        Seconds the orderly shutdown (``on_shutdown`` hooks, stopping nodes and loops) may
+        take. After a SIGINT/SIGTERM, once it has passed (or on a second signal), what is
+        still blocked is named on stderr and the process exits with status 124.
+    stall_threshold, priority_stall_threshold
+        Seconds a callback may hold the main / priority loop before the watchdog reports
+        the stall (once per callback, with its stack) and counts it in :meth:`statistics`.
     """
 
     def __init__(
@@ -84,6 +97,9 @@ class Runtime:
         priority_realtime: bool = False,
         handle_signals: bool = True,
         debug_messages: bool = False,
+        shutdown_timeout: float = SHUTDOWN_TIMEOUT_SEC,
+        stall_threshold: float = STALL_THRESHOLD_SEC,
+        priority_stall_threshold: float = PRIORITY_STALL_THRESHOLD_SEC,
     ) -> None:
         self._config = config
         if config is not None:
@@ -99,6 +115,27 @@ class Runtime:
             strict_qos = cfg.runtime.strict_qos
             priority_realtime = cfg.runtime.priority_realtime
             debug_messages = cfg.runtime.debug_messages
+            shutdown_timeout = cfg.runtime.shutdown_timeout
+            stall_threshold = cfg.runtime.stall_threshold
+            priority_stall_threshold = cfg.runtime.priority_stall_threshold
+        for name, value in (
+            ("shutdown_timeout", shutdown_timeout),
+            ("stall_threshold", stall_threshold),
+            ("priority_stall_threshold", priority_stall_threshold),
+        ):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+                raise ValueError(f"{name}: expected a number of seconds > 0, found {value!r}")
+        self.shutdown_timeout = float(shutdown_timeout)
+        self._stall_thresholds = {"main": float(stall_threshold), "priority": float(priority_stall_threshold)}
+        self._watchdog = Watchdog()
+        self._saved_handlers: dict[int, Any] = {}
+        #: what the shutdown had to leave running (a blocked loop thread), one line each
+        self.abandoned: list[str] = []
+        #: callback failures per (node, entity): count (the first is logged with its traceback)
+        self._failures: dict[tuple[str, str], int] = {}
+        self._failure_logged: dict[tuple[str, str], float] = {}
+        #: nodes whose on_start raised
+        self._failed_starts: list[str] = []
         if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
             raise ValueError(f"domain_id: expected an int in 0..232, found {domain_id!r}")
         self.transport = (
@@ -159,6 +196,7 @@ class Runtime:
         self._thread_id = threading.get_ident()
         self._waker = make_waker(self._loop, precise=True)
         self._shutdown_event = asyncio.Event()
+        self._watchdog.watch("main", self._loop, self._thread_id, self._stall_thresholds["main"])
         await self.transport.open(self._bus)
         if self.use_sim_time:
             from .msgs.rosgraph_msgs import Clock as ClockMsg
@@ -291,6 +329,8 @@ class Runtime:
             prio = PriorityLoop(realtime=self._priority_realtime)
             prio.start()
             self._priority = prio
+            assert prio.loop is not None and prio.thread_id is not None
+            self._watchdog.watch("priority", prio.loop, prio.thread_id, self._stall_thresholds["priority"])
             self._saved_switch_interval = sys.getswitchinterval()
             sys.setswitchinterval(min(self._saved_switch_interval, PRIORITY_SWITCH_INTERVAL_SEC))
         return self._priority
@@ -307,36 +347,90 @@ class Runtime:
             raise RuntimeError(f"spin needs an entered runtime: use `async with Runtime() as rt` ({self!r})")
         if duration_sec is not None and (isinstance(duration_sec, bool) or not duration_sec >= 0):
             raise ValueError(f"spin duration_sec: expected a number >= 0 or None, got {duration_sec!r}")
-        installed = self._install_signal_handlers()
-        try:
-            if duration_sec is None:
-                await self._shutdown_event.wait()
-            else:
-                try:
-                    await asyncio.wait_for(self._shutdown_event.wait(), duration_sec)
-                except TimeoutError:
-                    pass
-        finally:
-            for sig in installed:
-                assert self._loop is not None
-                self._loop.remove_signal_handler(sig)
+        self._install_signal_handlers()
+        if duration_sec is None:
+            await self._shutdown_event.wait()
+        else:
+            try:
+                await asyncio.wait_for(self._shutdown_event.wait(), duration_sec)
+            except TimeoutError:
+                pass
 
-    def _install_signal_handlers(self) -> list[signal.Signals]:
-        if not self._handle_signals or threading.current_thread() is not threading.main_thread():
-            return []
-        installed = []
-        assert self._loop is not None
+    def _install_signal_handlers(self) -> None:
+        """Python-level handlers, kept until the runtime has closed.
+
+        They run even while a callback blocks the main thread (a ``time.sleep`` is
+        interrupted for them), unlike ``loop.add_signal_handler``.
+        """
+        if self._saved_handlers or not self._handle_signals:
+            return
+        if threading.current_thread() is not threading.main_thread():
+            return
         for sig in (signal.SIGINT, signal.SIGTERM):
             try:
-                self._loop.add_signal_handler(sig, self._on_signal, sig)
-                installed.append(sig)
-            except (NotImplementedError, RuntimeError, ValueError):
+                self._saved_handlers[sig] = signal.signal(sig, self._on_signal_handler)
+            except (ValueError, OSError):  # pragma: no cover - not the main thread of the main interpreter
                 pass
-        return installed
+
+    def _restore_signal_handlers(self) -> None:
+        for sig, previous in self._saved_handlers.items():
+            signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
+        self._saved_handlers.clear()
+
+    def _on_signal_handler(self, signum: int, frame: Any) -> None:
+        # Runs between two bytecodes of the main thread: no logging, no locks here.
+        count = self._watchdog.on_signal(signal.Signals(signum).name, self.shutdown_timeout)
+        loop = self._loop
+        if count == 1 and loop is not None and not loop.is_closed():
+            loop.call_soon_threadsafe(self._on_signal, signum)
 
     def _on_signal(self, sig: int) -> None:
-        _log.info(f"{signal.Signals(sig).name} received: shutting down")
+        _log.info(
+            f"{signal.Signals(sig).name} received: shutting down (within {self.shutdown_timeout:g} s; "
+            "a second Ctrl-C abandons what is blocked)"
+        )
         self.shutdown()
+
+    def _add_emergency_stop(self, owner: str, fn: Any) -> None:
+        """Call ``fn()`` from the watchdog thread (no callback can block it) on SIGINT/SIGTERM."""
+        self._watchdog.add_emergency_stop(owner, fn)
+
+    def _remove_emergency_stop(self, fn: Any) -> None:
+        self._watchdog.remove_emergency_stop(fn)
+
+    def _record_failure(self, node: str, entity: str) -> tuple[int, bool]:
+        """Count one failure of ``entity`` in ``node``: (how many so far, whether to log it now)."""
+        from ._node import FAILURE_LOG_PERIOD_SEC
+
+        key = (node, entity)
+        count = self._failures.get(key, 0) + 1
+        self._failures[key] = count
+        now = time.monotonic()
+        last = self._failure_logged.get(key)
+        if last is None or now - last >= FAILURE_LOG_PERIOD_SEC:
+            self._failure_logged[key] = now
+            return count, True
+        return count, False
+
+    def _record_failed_start(self, node: Node, err: BaseException) -> None:
+        fqn = node.get_fully_qualified_name()
+        self._failed_starts.append(fqn)
+        policy = getattr(node, "_on_failure", "stop")
+        if policy == "stop":
+            _log.error(f"{fqn} failed to start ({type(err).__name__}: {err}); stopping the run")
+            self.shutdown()
+
+    def statistics(self) -> dict[str, Any]:
+        """Counts of what went wrong: stalls, callback failures and failed starts.
+
+        ``{"stalls": {(loop, node, entity): n}, "failures": {(node, entity): n},
+        "failed_starts": [node, ...]}``.
+        """
+        return {
+            "stalls": dict(self._watchdog.stalls),
+            "failures": dict(self._failures),
+            "failed_starts": list(self._failed_starts),
+        }
 
     def shutdown(self) -> None:
         """Ask ``spin`` to return (from any thread). ``async with`` then stops everything."""
@@ -366,63 +460,82 @@ class Runtime:
         if self._state in ("closing", "closed"):
             return
         self._state = "closing"
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + self.shutdown_timeout
+
+        def remaining() -> float:
+            return max(0.0, deadline - loop.time())
+
         nodes = list(self._nodes)
         # 1. on_shutdown hooks, each on its node's loop (controllers send their last command here).
         if nodes:
             # Scheduled after each node's _start on the same loop, so every hook sees a started node.
-            hooks = [self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown")) for n in nodes]
-            done, pending = await asyncio.wait(
-                [asyncio.ensure_future(h) for h in hooks] or [asyncio.ensure_future(asyncio.sleep(0))],
-                timeout=SHUTDOWN_HOOK_TIMEOUT_SEC,
-            )
+            hooks = [
+                asyncio.ensure_future(self._on_loop(n, n._run_hook(n.on_shutdown, "on_shutdown"))) for n in nodes
+            ]
+            done, pending = await asyncio.wait(hooks, timeout=remaining())
             for task in pending:
                 task.cancel()
-                _log.warning("an on_shutdown hook did not finish in time and was cancelled")
             if pending:
-                await asyncio.gather(*pending, return_exceptions=True)
+                late = [n.get_fully_qualified_name() for n, h in zip(nodes, hooks) if h in pending]
+                _log.warning(f"on_shutdown of {', '.join(late)} did not finish within shutdown_timeout; cancelled")
+                await asyncio.wait(pending, timeout=0.1)
             # 2. Let what the hooks published reach its subscribers.
-            await self._flush(nodes)
+            await self._flush(nodes, min(FLUSH_TIMEOUT_SEC, remaining()))
         # 3. Stop every node.
         for node in nodes:
             self._nodes.remove(node)
             self._detach(node)
         if self._stopping:
-            await asyncio.gather(
-                *[f if isinstance(f, asyncio.Future) else asyncio.wrap_future(f) for f in self._stopping],
-                return_exceptions=True,
-            )
+            stopping = [f if isinstance(f, asyncio.Future) else asyncio.wrap_future(f) for f in self._stopping]
+            _, late_stops = await asyncio.wait(stopping, timeout=max(remaining(), 0.05))
+            for f in late_stops:
+                f.cancel()
             self._stopping.clear()
         if self._clock_tap is not None:
             self._bus.remove(self._clock_tap)
             self._clock_tap = None
         # 4. Loops, transport, pools.
         if self._priority is not None:
-            self._priority.stop()
+            prio = self._priority
+            if prio.loop is not None:
+                self._watchdog.unwatch(prio.loop)
+            blocked = self._watchdog.describe_blocked()
+            if not prio.stop(timeout=max(remaining(), 0.05)):
+                what = [b for b in blocked if b.startswith("priority")] or ["priority loop: blocked"]
+                self.abandoned.extend(what)
+                _log.error(f"the priority loop did not stop within shutdown_timeout; abandoned: {'; '.join(what)}")
             self._priority = None
             if self._saved_switch_interval is not None:
                 sys.setswitchinterval(self._saved_switch_interval)
         await self.transport.close()
         if self._processes is not None:
-            self._processes.shutdown(wait=True, cancel_futures=True)
+            self._processes.shutdown(wait=not self.abandoned, cancel_futures=True)
             self._processes = None
         if self._threads is not None:
-            self._threads.shutdown(wait=True, cancel_futures=True)
+            self._threads.shutdown(wait=not self.abandoned, cancel_futures=True)
             self._threads = None
         if self._waker is not None:
             self._waker.close()
             self._waker = None
+        self._restore_signal_handlers()
+        if not self.abandoned:
+            self._watchdog.finished()  # disarm the deadline; with something abandoned it still fires
         self._state = "closed"
 
-    async def _flush(self, nodes: list[Node]) -> None:
+    async def _flush(self, nodes: list[Node], timeout_sec: float = FLUSH_TIMEOUT_SEC) -> None:
         """Wait (bounded) until every subscription has handled what is queued for it."""
         loop = asyncio.get_running_loop()
-        deadline = loop.time() + FLUSH_TIMEOUT_SEC
+        deadline = loop.time() + timeout_sec
         quiet_rounds = 0
         while loop.time() < deadline:
             await asyncio.sleep(0)
             if self._priority is not None and self._priority.loop is not None:
                 # A round trip through the priority loop drains its call_soon_threadsafe queue.
-                await self._priority.run(asyncio.sleep(0))
+                try:
+                    await asyncio.wait_for(self._priority.run(asyncio.sleep(0)), max(0.0, deadline - loop.time()))
+                except TimeoutError:
+                    return
             if all(n._idle() for n in nodes):
                 quiet_rounds += 1
                 if quiet_rounds >= 2:
@@ -439,6 +552,8 @@ class Runtime:
         if self._processes is None:
             import concurrent.futures
             import multiprocessing
+
+            _check_main_guard()
 
             method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
             self._processes = concurrent.futures.ProcessPoolExecutor(
@@ -493,6 +608,27 @@ class Runtime:
             if s.name.endswith(suffix)
         )
         return Graph(nodes, tuple(topics), tuple(self._bus.incompatibilities()), services, actions)
+
+
+_MAIN_GUARD = re.compile(r"""__name__\s*==\s*['"]__main__['"]""")
+
+
+def _check_main_guard() -> None:
+    """Process workers import the main script: without the guard it would run again in each."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if main is None or path is None or getattr(main, "__spec__", None) is not None:
+        return  # interactive, ``python -m``, or a console script: nothing to re-run
+    try:
+        with open(path, encoding="utf-8") as f:
+            source = f.read()
+    except (OSError, UnicodeDecodeError):
+        return
+    if not _MAIN_GUARD.search(source):
+        raise RuntimeError(
+            f"offload starts worker processes that import {os.path.basename(path)}: put its entry point "
+            f'under `if __name__ == "__main__":` (e.g. `if __name__ == "__main__": aiorobot.run(main())`)'
+        )
 
 
 def run(main: Coroutine[Any, Any, T], *, debug: bool | None = None) -> T:

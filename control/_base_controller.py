@@ -214,7 +214,20 @@ class BaseController(Node):
         msg.velocity = np.asarray(wheels, dtype=np.float64).copy()
         self.wheel_pub.publish(msg)
 
+    async def on_start(self) -> None:
+        self.runtime._add_emergency_stop(self.get_fully_qualified_name(), self._emergency_stop)
+
+    def _emergency_stop(self) -> None:
+        """On SIGINT/SIGTERM, before anything else: publish zero wheel speeds.
+
+        Runs in the runtime's watchdog thread, so a callback blocking this node's loop
+        cannot delay it (publishing is thread-safe).
+        """
+        self.target = np.zeros(3)
+        self._publish_wheels(np.zeros(self.kinematics.n_wheels))
+
     async def on_shutdown(self) -> None:
+        self.runtime._remove_emergency_stop(self._emergency_stop)
         self.target = np.zeros(3)
         self.smoother.reset()
         self.wheel_command = np.zeros(self.kinematics.n_wheels)

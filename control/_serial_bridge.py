@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import time
 from typing import Any
 
@@ -24,6 +25,7 @@ from ._messages import (
     SetWheelVelocities,
     VersionRequest,
     VersionResponse,
+    encode_message,
 )
 from ._odometry import tick_delta
 from ._serial_link import SerialLink
@@ -62,7 +64,9 @@ class SerialMotorBridge(Node):
     def __init__(self, **kw: Any) -> None:
         super().__init__("serial_motor_bridge", **kw)
         p = self.declare_parameter
-        self.port = p("port", "/dev/ttyUSB0", description="serial device path or pyserial URL").value
+        self.port = p(
+            "port", "/dev/ttyUSB0", description="serial device path or pyserial URL; {pid} is this process's id"
+        ).value.replace("{pid}", str(os.getpid()))
         self.baud_rate = p("baud_rate", 115200, description="line speed", range=(1200, 12_000_000)).value
         self.joint_names = [str(n) for n in p("joint_names", list(_DEFAULT_JOINTS), description="wheel joints, firmware order").value]
         self.heartbeat_period_sec = p("heartbeat_period_sec", 0.1, description="host heartbeat period", range=(0.005, 10.0)).value
@@ -117,9 +121,27 @@ class SerialMotorBridge(Node):
     # -- lifecycle -----------------------------------------------------------------------
 
     async def on_start(self) -> None:
+        self.runtime._add_emergency_stop(self.get_fully_qualified_name(), self._emergency_stop)
         self._try_connect(time.monotonic())
 
+    def _emergency_stop(self) -> None:
+        """On SIGINT/SIGTERM, before anything else: write a zero wheel command to the port.
+
+        Runs in the runtime's watchdog thread and writes straight to the descriptor, so a
+        callback blocking the loop cannot delay it. The leading delimiter ends any frame
+        the loop was half-way through, so the firmware decodes this one.
+        """
+        fd = self.link._fd
+        if fd is None or not self.link.connected:
+            return
+        frame = b"\x00" + encode_message(SetWheelVelocities((0.0,) * len(self.joint_names)), 0)
+        try:
+            os.write(fd, frame)
+        except OSError as err:  # a full or vanished port: the on_shutdown path tries again
+            self.get_logger().warning(f"emergency zero command to {self.port} not written: {err}")
+
     async def on_shutdown(self) -> None:
+        self.runtime._remove_emergency_stop(self._emergency_stop)
         self._shutting_down = True
         if self.link.connected:
             self.link.send(SetWheelVelocities((0.0,) * len(self.joint_names)))
@@ -209,7 +231,7 @@ class SerialMotorBridge(Node):
     def _on_firmware_heartbeat(self, message: FirmwareHeartbeat) -> None:
         self._last_firmware_heartbeat = time.monotonic()
         if message.status != self.firmware_status:
-            self.get_logger().info(f"firmware status {message.status!r}")
+            self.get_logger().info(f"firmware status {message.status.name or int(message.status)}")
         self.firmware_status = message.status
         if not self.firmware_alive:
             self.firmware_alive = True

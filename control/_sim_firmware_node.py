@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import os
 from typing import Any
 
 from aiorobot import Node
@@ -22,7 +23,9 @@ class SimulatedFirmwareNode(Node):
     def __init__(self, **kw: Any) -> None:
         super().__init__("simulated_firmware", **kw)
         p = self.declare_parameter
-        self.port_link = p("port_link", "/tmp/aiorobot-sim-motors", description="symlink to the pty slave").value
+        self.port_link = p(
+            "port_link", "/tmp/aiorobot-sim-motors", description="symlink to the pty slave; {pid} is this process's id"
+        ).value.replace("{pid}", str(os.getpid()))
         firmware = SimulatedFirmware(
             wheel_count=p("wheel_count", 4, description="number of motors", range=(1, 8)).value,
             ticks_per_revolution=p("ticks_per_revolution", 4096, description="encoder resolution", range=(1, 1_000_000)).value,
@@ -56,7 +59,7 @@ class SimulatedFirmwareNode(Node):
         stats = fw.decoder.statistics()
         return (
             f"{self.get_name()}: {fw.commands_received} wheel commands, {stats.frames_ok} frames from the host "
-            f"({stats.bad_frames} bad), final status {fw.status!r}"
+            f"({stats.bad_frames} bad), final status {fw.status.name or int(fw.status)}"
         )
 
     async def on_shutdown(self) -> None:

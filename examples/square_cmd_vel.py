@@ -11,7 +11,7 @@ from typing import Any
 from aiorobot import Node
 from aiorobot.msgs.geometry_msgs import Twist
 
-__all__ = ["SquareCmdVel"]
+__all__ = ["SquareCmdVel", "main"]
 
 # forward, left, backward, right: one side each
 _SIDES = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))
@@ -55,3 +55,20 @@ class SquareCmdVel(Node):
         self.pub.publish(self.command_at(self.elapsed_sec))
         self.elapsed_sec += self.period_sec
         self.sent += 1
+
+
+def main() -> None:
+    """Run as a script: print the square it drives, and how to drive a simulated base with it."""
+    node = SquareCmdVel()
+    print(f"SquareCmdVel publishes geometry_msgs/Twist on {node.pub.topic_name} every {node.period_sec:g} s:")
+    total = 4 * (node.side_sec + (0.0 if node.strafe else node.turn_sec))
+    steps = 8
+    for i in range(steps + 1):
+        t = total * i / steps
+        msg = node.command_at(t)
+        print(f"  t={t:5.2f} s  linear.x={msg.linear.x:+.2f} linear.y={msg.linear.y:+.2f} angular.z={msg.angular.z:+.2f}")
+    print("Drive a simulated mecanum base with it: aiorobot run examples/mecanum_serial.toml --duration 5")
+
+
+if __name__ == "__main__":
+    main()

@@ -51,6 +51,10 @@ def configure_logging(level: str, stream: TextIO | None = None) -> logging.Handl
         handler = logging.StreamHandler(stream)
         handler.setFormatter(NodeFormatter())
     logger = logging.getLogger("aiorobot")
+    from aiorobot import _logging
+
+    if _logging._default_handler is not None:
+        logger.removeHandler(_logging._default_handler)
     for old in [h for h in logger.handlers if getattr(h, "_aiorobot_cli", False)]:
         logger.removeHandler(old)
     setattr(handler, "_aiorobot_cli", True)  # marks the handler this CLI installed  # noqa: B010

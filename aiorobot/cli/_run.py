@@ -1,15 +1,19 @@
 """``aiorobot run [CONFIG.toml] [--duration SEC]``: run a graph of nodes from a config file.
 
 Everything is loaded, imported, constructed and checked before the runtime starts, so a
-bad file starts no node. SIGINT and SIGTERM shut the runtime down cleanly (exit 0).
+bad file starts no node. SIGINT and SIGTERM shut the runtime down cleanly.
+
+Exit status: 0 after a clean run; 1 when a node failed to start or any callback raised
+(listed per node and entity on stderr; ``--keep-going`` only keeps the other nodes
+running); 2 for a bad configuration; 124 when the shutdown did not finish within
+``runtime.shutdown_timeout`` or a second signal abandoned what was blocked; 130 when
+interrupted before the runtime started.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import logging
-import signal
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -17,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 from ._parser import positive_seconds
 
 if TYPE_CHECKING:
-    from aiorobot import Runtime
+    from aiorobot import Node, Runtime
     from aiorobot._config import GraphConfig
 
 __all__ = ["add_arguments", "main"]
@@ -26,6 +30,8 @@ __all__ = ["add_arguments", "main"]
 EXIT_CONFIG_ERROR = 2
 #: exit status when interrupted before the runtime could install its signal handlers
 EXIT_INTERRUPTED = 130
+#: exit status when a node failed to start or a callback raised (with or without --keep-going)
+EXIT_FAILED = 1
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -60,6 +66,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="SEC",
         help="seconds between status lines (default: 1)",
     )
+    parser.add_argument(
+        "--keep-going",
+        action="store_true",
+        help="a node whose on_start raises does not stop the run (as on_failure = \"continue\" for "
+        "nodes that leave on_failure at \"stop\"); the exit status is still 1 when a node failed "
+        "to start or a callback raised",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -78,6 +91,13 @@ def main(args: argparse.Namespace) -> int:
         config_path: Path = DEFAULT_CONFIG
     else:
         config_path = args.config
+    if config_path.suffix == ".py":
+        print(
+            f"{config_path}: expected a TOML graph file (aiorobot run graph.toml), found a Python file; "
+            f"to run one node class from it, use aiorobot run {config_path.stem}:ClassName",
+            file=sys.stderr,
+        )
+        return EXIT_CONFIG_ERROR
     try:
         config = load_config(config_path)
     except ConfigError as err:
@@ -90,65 +110,87 @@ def main(args: argparse.Namespace) -> int:
 
     configure_logging(config.runtime.log_level)
     try:
-        return aiorobot.run(_serve(config, args.duration, args.status_period))
+        from aiorobot._config_build import build_nodes
+
+        # Constructors run here, outside the event loop: a Ctrl-C interrupts one that blocks.
+        nodes = build_nodes(config)  # raises ConfigError before anything starts
+        return aiorobot.run(_serve(config, nodes, args.duration, args.status_period, args.keep_going))
     except ConfigError as err:
         print(err, file=sys.stderr)
         return EXIT_CONFIG_ERROR
     except KeyboardInterrupt:  # before the signal handlers were in place
+        print("interrupted before the graph started", file=sys.stderr)
         return EXIT_INTERRUPTED
 
 
-async def _serve(config: GraphConfig, duration_sec: float | None, status_period_sec: float) -> int:
+async def _serve(
+    config: GraphConfig,
+    nodes: list[tuple[Node, str]],
+    duration_sec: float | None,
+    status_period_sec: float,
+    keep_going: bool = False,
+) -> int:
     from aiorobot import Runtime
     from aiorobot._config import ConfigError
-    from aiorobot._config_build import build_nodes
-
     from ._status import StatusDisplay
 
-    nodes = build_nodes(config)  # raises ConfigError before anything starts
+    for (node, _), node_config in zip(nodes, config.nodes):
+        node._on_failure = "continue" if keep_going and node_config.on_failure == "stop" else node_config.on_failure
     runtime_config = config.runtime
-    loop = asyncio.get_running_loop()
-    signals = (signal.SIGINT, signal.SIGTERM)
-    try:
-        from aiorobot._transport import make_transport
+    from aiorobot._transport import make_transport
 
-        transport: Any = runtime_config.transport
-        if runtime_config.zenoh_config:
-            transport = make_transport("zenoh", domain_id=runtime_config.domain_id, config_file=runtime_config.zenoh_config)
-        async with Runtime(
-            transport=transport,
-            domain_id=runtime_config.domain_id,
-            use_sim_time=runtime_config.use_sim_time,
-            strict_qos=runtime_config.strict_qos,
-            priority_realtime=runtime_config.priority_realtime,
-            debug_messages=runtime_config.debug_messages,
-            handle_signals=False,  # ours stay installed until the runtime has fully shut down
-        ) as rt:
-            for signum in signals:
-                loop.add_signal_handler(signum, _on_signal, rt, signum)
-            if runtime_config.strict_qos:  # the graph as written cannot connect: refuse it whole
-                for problem in rt.check_qos([node for node, _ in nodes]):
-                    owners = {problem.publisher_node, problem.subscription_node}
-                    index = max(i for i, (n, _) in enumerate(nodes) if n.get_fully_qualified_name() in owners)
-                    raise ConfigError(
-                        config.path,
-                        config.nodes[index].key,
-                        f"runtime.strict_qos is set and incompatible QoS on {problem.topic}: "
-                        f"{problem.publisher} does not connect to {problem.subscription} ({problem.reason})",
-                    )
-            rt.add_nodes(nodes)
-            display = StatusDisplay(
-                [node for node, _ in nodes], period_sec=status_period_sec, on_stream_closed=rt.shutdown
-            )
-            async with display:
-                await rt.spin(duration_sec=duration_sec)
-    finally:  # kept until the runtime has shut down: a second Ctrl-C must not interrupt that
-        for signum in signals:
-            loop.remove_signal_handler(signum)
-    return 0
+    transport: Any = runtime_config.transport
+    if runtime_config.zenoh_config:
+        transport = make_transport("zenoh", domain_id=runtime_config.domain_id, config_file=runtime_config.zenoh_config)
+    async with Runtime(
+        transport=transport,
+        domain_id=runtime_config.domain_id,
+        use_sim_time=runtime_config.use_sim_time,
+        strict_qos=runtime_config.strict_qos,
+        priority_realtime=runtime_config.priority_realtime,
+        debug_messages=runtime_config.debug_messages,
+        shutdown_timeout=runtime_config.shutdown_timeout,
+        stall_threshold=runtime_config.stall_threshold,
+        priority_stall_threshold=runtime_config.priority_stall_threshold,
+    ) as rt:
+        # Signal handlers stay installed until the runtime has fully shut down: a second
+        # Ctrl-C abandons what is blocked, a first one past shutdown_timeout too.
+        if runtime_config.strict_qos:  # the graph as written cannot connect: refuse it whole
+            for problem in rt.check_qos([node for node, _ in nodes]):
+                owners = {problem.publisher_node, problem.subscription_node}
+                index = max(i for i, (n, _) in enumerate(nodes) if n.get_fully_qualified_name() in owners)
+                raise ConfigError(
+                    config.path,
+                    config.nodes[index].key,
+                    f"runtime.strict_qos is set and incompatible QoS on {problem.topic}: "
+                    f"{problem.publisher} does not connect to {problem.subscription} ({problem.reason})",
+                )
+        rt.add_nodes(nodes)
+        display = StatusDisplay(
+            [node for node, _ in nodes], period_sec=status_period_sec, on_stream_closed=rt.shutdown
+        )
+        async with display:
+            await rt.spin(duration_sec=duration_sec)
+    return _outcome(rt)
 
 
-def _on_signal(rt: Runtime, signum: int) -> None:
-    if not rt.is_shutdown:
-        logging.getLogger("aiorobot.cli").info(f"{signal.Signals(signum).name} received: shutting down")
-    rt.shutdown()
+def _outcome(rt: Runtime) -> int:
+    """Print what went wrong during the run; 1 if a node failed to start or a callback raised."""
+    from aiorobot._watchdog import EXIT_SHUTDOWN_TIMEOUT
+
+    stats = rt.statistics()
+    lines = []
+    for fqn in stats["failed_starts"]:
+        lines.append(f"  {fqn}: failed to start (on_start raised)")
+    for (fqn, entity), count in sorted(stats["failures"].items()):
+        if entity == "on_start" and fqn in stats["failed_starts"]:
+            continue
+        lines.append(f"  {fqn}: {entity} raised {count} time{'s' if count != 1 else ''}")
+    for (loop, fqn, entity), count in sorted(stats["stalls"].items()):
+        lines.append(f"  {fqn}: {entity} stalled the {loop} loop {count} time{'s' if count != 1 else ''}")
+    if lines:
+        print("failures:\n" + "\n".join(lines), file=sys.stderr)
+    if rt.abandoned:
+        print("abandoned at shutdown: " + "; ".join(rt.abandoned), file=sys.stderr)
+        return EXIT_SHUTDOWN_TIMEOUT
+    return EXIT_FAILED if stats["failed_starts"] or stats["failures"] else 0

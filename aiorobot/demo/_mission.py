@@ -156,7 +156,7 @@ async def run_demo(
     sx, sy, syaw = loaded.start
     wall0, cpu0 = time.perf_counter(), time.process_time()
     # The simulator compiles its Numba kernels when it starts: seconds on the main loop, on purpose.
-    async with Runtime(use_sim_time=True, stall_threshold_sec=10.0) as rt:
+    async with Runtime(use_sim_time=True, stall_threshold=10.0) as rt:
         sim = rt.add_node(Simulator(parameter_overrides={
             "world": world, "robot": "mecanum", "seed": seed, "real_time_factor": rtf,
             "publish_odom_tf": True, "camera_rate": 0.0,

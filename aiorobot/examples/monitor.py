@@ -41,6 +41,8 @@ class RateMonitor(Node):
     def status_line(self) -> str:
         """One short line for ``aiorobot run``'s live status display."""
         s = self.stats.recent(self.now().nanoseconds)
+        if s.count == 0:
+            return f"{self.get_name()}: {self.subscription.topic_name} no messages yet"
         return (
             f"{self.get_name()}: {self.subscription.topic_name} {s.count} msgs {s.rate_hz:5.1f} Hz "
             f"latency p50 {s.latency_p50_us:.0f} us max {s.latency_max_us:.0f} us"
@@ -49,6 +51,8 @@ class RateMonitor(Node):
     def summary(self) -> str:
         """The end-of-run summary for ``aiorobot run``."""
         s = self.stats.total()
+        if s.count == 0:
+            return f"{self.get_name()}: no messages yet on {self.subscription.topic_name}"
         return (
             f"{self.get_name()}: received {s.count} messages on {self.subscription.topic_name}, "
             f"mean rate {s.rate_hz:.1f} Hz, latency p50 {s.latency_p50_us:.0f} us, "

@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import AsyncIterator
+from typing import Any
+
+import pytest
+
+#: the fixtures this plugin provides; an ``async def`` test using one runs under pytest-asyncio
+FIXTURES = frozenset({"runtime", "sim_runtime", "sim_clock"})
 
 try:
     import pytest_asyncio
@@ -31,3 +38,21 @@ if pytest_asyncio is not None:
         clock = SimClock(sim_runtime, start_sec=1.0)
         await clock.start()
         return clock
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_pycollect_makeitem(collector: Any, name: str, obj: Any) -> None:
+    """Mark ``async def`` tests that use our fixtures with ``pytest.mark.asyncio``.
+
+    So they run in a project that leaves pytest-asyncio in its default strict mode
+    (no ``asyncio_mode = "auto"`` needed).
+    """
+    if pytest_asyncio is None or not inspect.iscoroutinefunction(obj):
+        return
+    try:
+        uses = FIXTURES & set(inspect.signature(obj).parameters)
+    except (TypeError, ValueError):
+        return
+    marks = getattr(obj, "pytestmark", [])
+    if uses and not any(getattr(m, "name", "") == "asyncio" for m in marks):
+        obj.pytestmark = [*marks, pytest.mark.asyncio]
