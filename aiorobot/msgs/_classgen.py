@@ -15,7 +15,8 @@ import numpy as np
 
 from ._spec import ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
 
-__all__ = ["Action", "Message", "Service", "build_class"]
+__all__ = ["Action", "FrozenList", "Message", "ReadOnlyMessageError", "Service", "build_class",
+           "freezer"]
 
 _ndarray = np.ndarray
 
@@ -26,6 +27,8 @@ class Message:
     __slots__ = ()
     __msgtype__: ClassVar[str] = ""
     _field_types: ClassVar[dict[str, str]] = {}
+    _base: ClassVar[type[Message]]  # the generated class itself; read-only twins inherit it
+    _frozen: ClassVar[bool] = False  # True on the read-only twins that subscribers receive
 
     @classmethod
     def get_fields_and_field_types(cls) -> dict[str, str]:
@@ -35,9 +38,103 @@ class Message:
     def __reduce__(self) -> tuple[Any, ...]:
         from ._registry import rebuild
 
-        return rebuild, (self.__msgtype__, tuple(getattr(self, n) for n in self.__slots__))
+        return rebuild, (self.__msgtype__, tuple(getattr(self, n) for n in self._base.__slots__))
+
+    def copy(self) -> Any:
+        """A deep, mutable copy (numpy arrays copied): what to change instead of a received message."""
+        import copy
+
+        return copy.deepcopy(self)
 
     __hash__ = None  # type: ignore[assignment]  # mutable, compared by value
+
+
+#: Arrays of at least this many bytes are shared (made read-only) at publish; smaller ones are copied.
+SHARE_BYTES = 4096
+
+
+class ReadOnlyMessageError(AttributeError):
+    """Raised on an attempt to change a message as delivered to subscribers."""
+
+
+class FrozenList(list):  # type: ignore[type-arg]
+    """A list that refuses changes: the sequence fields of a delivered message."""
+
+    __slots__ = ()
+
+    def _refuse(self, *_args: Any, **_kwargs: Any) -> Any:
+        raise ReadOnlyMessageError("this list belongs to a published message; copy it with list(...) "
+                                   "or copy the message with .copy()")
+
+    append = extend = insert = remove = pop = clear = sort = reverse = _refuse
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = _refuse
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return list, (list(self),)
+
+    def __copy__(self) -> list[Any]:
+        return list(self)
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> list[Any]:
+        import copy
+
+        return [copy.deepcopy(x, memo) for x in self]
+
+
+def _readonly_array(a: np.ndarray) -> np.ndarray:
+    """What a subscriber gets for an array field: large ones shared, small ones copied; both read-only."""
+    if not a.flags.writeable:
+        return a
+    if a.nbytes >= SHARE_BYTES:
+        a.flags.writeable = False  # the publisher's array too: a write after publish raises
+        return a
+    b = a.copy()
+    b.flags.writeable = False
+    return b
+
+
+class _Freezer(dict):  # type: ignore[type-arg]
+    """Message class -> its read-only twin for one topic (created on first use)."""
+
+    def __init__(self, topic: str) -> None:
+        super().__init__()
+        self.topic = topic
+
+    def __missing__(self, cls: type) -> type:
+        twin = self[cls] = _frozen_twin(cls, self.topic)
+        return twin
+
+
+_FREEZERS: dict[str, _Freezer] = {}
+
+
+def freezer(topic: str) -> _Freezer:
+    """The shared class table of read-only twins for messages published on ``topic``."""
+    f = _FREEZERS.get(topic)
+    if f is None:
+        f = _FREEZERS[topic] = _Freezer(topic)
+    return f
+
+
+def _frozen_twin(cls: type, topic: str) -> type:
+    short = cls.__name__
+    text = (f"this {short} was published on {topic}; publish a new one or .copy() it "
+            "(subscribers share what was published)")
+
+    def __setattr__(self: Any, name: str, value: Any) -> None:
+        raise ReadOnlyMessageError(text)
+
+    def __delattr__(self: Any, name: str) -> None:
+        raise ReadOnlyMessageError(text)
+
+    def __new__(twin: type, *args: Any, **kwargs: Any) -> Any:
+        return cls(*args, **kwargs)  # type(received)(...) builds a mutable message
+
+    twin = type(cls)(short, (cls,), {"__slots__": (), "__setattr__": __setattr__,
+                                      "__delattr__": __delattr__, "__new__": __new__,
+                                      "_frozen": True, "__module__": cls.__module__})
+    twin.__qualname__ = cls.__qualname__
+    return twin
 
 
 class _InterfaceMeta(type):
@@ -164,6 +261,24 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
             fresh = f"[_T{i}() for _ in range({t.count})]" if t.kind == ARRAY else "[]"
             body.append(f"self.{n} = {fresh} if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
+    freeze = ["def _fz(m, F):", "    if m._frozen:", "        return m", "    c = _new(F[_Self])"]
+    for i, f in enumerate(spec.fields):
+        t = f.type
+        n = f.name
+        if t.kind == SCALAR and not t.is_message:
+            freeze.append(f"    _S{i}(c, m.{n})")
+        elif t.kind == SCALAR:
+            freeze.append(f"    _S{i}(c, _T{i}._fz(m.{n}, F))")
+        elif t.is_primitive:
+            freeze.append(f"    _S{i}(c, _ro(m.{n}))")
+        elif t.is_string:
+            freeze.append(f"    _S{i}(c, _FL(m.{n}))")
+        else:
+            freeze.append(f"    _S{i}(c, _FL([x._fz(x, F) for x in m.{n}]))")
+    freeze.append("    return c")
+    binds: list[str] = []
+    expr = _copy_expr(spec, "_Self", "m", ns, get, binds)
+    freeze += ["def _cp(m, F=None):", *(f"    {b}" for b in binds), f"    return {expr}"]
     dotted = spec.name.replace("/", ".")
     reprs = ", ".join(f"{n}={{self.{n}!r}}" for n in names)
     lines = [
@@ -177,13 +292,38 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
         f"    def __init__(self, {', '.join(params)}):",
         *(f"        {b}" for b in body),
         "    def __eq__(self, other):",
-        "        if other.__class__ is not self.__class__:",
+        "        if getattr(other.__class__, '_base', None) is not self._base:",
         "            return NotImplemented",
         f"        return bool({' and '.join(eq)})",
         "    def __repr__(self):",
         f"        return f'{dotted}({reprs})'",
     ]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n", "\n".join(freeze) + "\n"
+
+
+def _copy_expr(spec: MsgSpec, cls_name: str, src: str, ns: dict[str, Any],
+               get: Callable[[str], type], binds: list[str]) -> str:
+    """One expression building a copy of ``src``, nested messages inlined (their sources bound
+    to locals in ``binds``): scalars shared, arrays through ``_ro``, sequences as FrozenList."""
+    args = []
+    for f in spec.fields:
+        t = f.type
+        ref = f"{src}.{f.name}"
+        if t.kind == SCALAR and not t.is_message:
+            args.append(ref)
+        elif t.kind == SCALAR:
+            k = len(binds) + 1
+            nested = get(t.base)
+            ns[f"_C{k}"] = nested
+            binds.append(f"_v{k} = {ref}")
+            args.append(_copy_expr(nested._spec, f"_C{k}", f"_v{k}", ns, get, binds))  # type: ignore[attr-defined]
+        elif t.is_primitive:
+            args.append(f"_ro({ref})")
+        elif t.is_string:
+            args.append(f"_FL({ref})")
+        else:
+            args.append(f"_FL([x._cp(x) for x in {ref}])")
+    return f"{cls_name}({', '.join(args)})"
 
 
 def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> type:
@@ -191,10 +331,17 @@ def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> 
         "_Message": Message, "_zeros": np.zeros, "_empty": np.empty, "_arr": as_array,
         "_farr": as_fixed_array, "_aeq": np.array_equal,
     }
-    source = _class_source(spec, ns, get)
+    source, freeze = _class_source(spec, ns, get)
     code = compile(source, f"<aiorobot.msgs {spec.name}>", "exec")
     exec(code, ns)  # noqa: S102 - source generated from a validated spec
     cls: type = ns[spec.short_name]
+    ns.update(_Self=cls, _new=object.__new__, _ro=_readonly_array, _FL=FrozenList)
+    ns.update({f"_S{i}": cls.__dict__[f.name].__set__ for i, f in enumerate(spec.fields)})
+    exec(compile(freeze, f"<aiorobot.msgs {spec.name} freeze>", "exec"), ns)  # noqa: S102
+    cls._fz = staticmethod(ns["_fz"])  # type: ignore[attr-defined]
+    cls._cp = staticmethod(ns["_cp"])  # type: ignore[attr-defined]
+    cls._base = cls  # type: ignore[attr-defined]
+    cls._frozen = False  # type: ignore[attr-defined]
     cls.__module__ = f"aiorobot.msgs.{spec.package}"
     cls.__qualname__ = qualname
     cls.__doc__ = f"ROS 2 message {spec.name}."
