@@ -134,6 +134,9 @@ class Publisher(Endpoint, Generic[M]):
         ``msg`` stays the caller's to change and publish again, except its numpy arrays of
         ``SHARE_BYTES`` or more, which subscribers share: those become read-only (assign a
         new array instead).
+
+        rclpy difference: subscribers of one publish share one copy, whose arrays and
+        sequences are read-only (docs/rclpy-differences.md).
         """
         if not isinstance(msg, self.msg_type):
             raise TypeError(
