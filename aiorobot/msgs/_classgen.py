@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ._spec import ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
+from ._spec import _INT_RANGES, ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
 
 __all__ = ["Action", "FrozenList", "Message", "ReadOnlyMessageError", "Service", "build_class",
            "freezer"]
@@ -22,7 +22,15 @@ _ndarray = np.ndarray
 
 
 class Message:
-    """Base class of every generated message class."""
+    """Base class of every generated message class.
+
+    Constructor arguments are checked as rclpy's generated classes check them: type, integer
+    and float32 range, string bounds, item types of sequences; a bad one raises TypeError or
+    ValueError naming the field. Assignments after construction are not checked.
+
+    rclpy difference: float fields accept ints and numpy numbers (stored as float); rclpy
+    accepts only float. Assignment is not checked (rclpy checks every assignment).
+    """
 
     __slots__ = ()
     __msgtype__: ClassVar[str] = ""
@@ -202,6 +210,82 @@ def as_fixed_array(value: Any, dtype: np.dtype[Any], count: int, where: str) -> 
     return arr
 
 
+_F32_MAX = 3.4028234663852886e38
+
+
+def _got(value: Any) -> str:
+    return f"{type(value).__name__} {value!r:.60}"
+
+
+def check_float(value: Any, where: str, base: str) -> float:
+    """A float field's value: floats, ints and numpy numbers (as float); else TypeError."""
+    if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        value = float(value)
+    else:
+        raise TypeError(f"{where} expects a float ({base}), got {_got(value)}")
+    if base == "float32" and abs(value) > _F32_MAX and value == value and abs(value) != float("inf"):
+        raise ValueError(f"{where}: {value!r} is out of range for float32")
+    return value
+
+
+def check_int(value: Any, where: str, base: str) -> int:
+    """An integer field's value: ints (and bools, numpy integers) in the type's range."""
+    if isinstance(value, (int, np.integer)):
+        value = int(value)
+    else:
+        raise TypeError(f"{where} expects an int ({base}), got {_got(value)}")
+    lo, hi = _INT_RANGES[base]
+    if not lo <= value <= hi:
+        raise ValueError(f"{where}: {value} is out of range for {base} [{lo}, {hi}]")
+    return value
+
+
+def check_bool(value: Any, where: str) -> bool:
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{where} expects a bool, got {_got(value)}")
+
+
+def check_str(value: Any, where: str, bound: int) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{where} expects a str, got {_got(value)}")
+    if bound and len(value) > bound:
+        raise ValueError(f"{where} is bounded to {bound} characters, got {len(value)}")
+    return str(value)
+
+
+def check_message(value: Any, cls: type, where: str) -> Any:
+    if not isinstance(value, cls):
+        raise TypeError(f"{where} expects a {cls.__msgtype__} message, got {_got(value)}")  # type: ignore[attr-defined]
+    return value
+
+
+def check_list(value: Any, item: Any, where: str, what: str) -> list[Any]:
+    """A sequence field of strings or messages: a list (or tuple) whose items are ``item``."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{where} expects a list of {what}, got {_got(value)}")
+    value = value if isinstance(value, list) else list(value)
+    for i, x in enumerate(value):
+        if not isinstance(x, item):
+            raise TypeError(f"{where}[{i}] expects a {what}, got {_got(x)}")
+    return value  # type: ignore[no-any-return]
+
+
+def checked_array(value: Any, dtype: np.dtype[Any], where: str) -> np.ndarray:
+    try:
+        return as_array(value, dtype)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise (TypeError if isinstance(exc, TypeError) else ValueError)(
+            f"{where} expects a sequence of {dtype.name}: {exc}") from None
+
+
+def checked_fixed_array(value: Any, dtype: np.dtype[Any], count: int, where: str) -> np.ndarray:
+    arr = checked_array(value, dtype, where)
+    if arr.shape[0] != count:
+        raise ValueError(f"{where} is a fixed array of {count} elements, got {arr.shape[0]}")
+    return arr
+
+
 def _zero_literal(base: str) -> str:
     if base == "bool":
         return "False"
@@ -215,6 +299,7 @@ def _zero_literal(base: str) -> str:
 def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type]) -> str:
     names = [f.name for f in spec.fields]
     params: list[str] = []
+    checks: list[str] = []  # skipped when _t (a copy made by _cp from a checked message)
     body: list[str] = []
     eq: list[str] = []
     for i, f in enumerate(spec.fields):
@@ -224,12 +309,25 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
         if t.kind == SCALAR and not t.is_message:
             default = repr(f.default) if f.default is not None else _zero_literal(t.base)
             params.append(f"{n}={default}")
+            if t.base in ("float32", "float64"):
+                lim = "" if t.base == "float64" else f" or not -{_F32_MAX!r} <= {n} <= {_F32_MAX!r}"
+                checks.append(f"if {n}.__class__ is not float{lim}: {n} = _chf({n}, {where!r}, {t.base!r})")
+            elif t.base == "bool":
+                checks.append(f"if {n}.__class__ is not bool: {n} = _chb({n}, {where!r})")
+            elif t.is_string:
+                lim = f" or len({n}) > {t.string_bound}" if t.string_bound else ""
+                checks.append(f"if {n}.__class__ is not str{lim}: {n} = _chs({n}, {where!r}, {t.string_bound})")
+            else:
+                lo, hi = _INT_RANGES[t.base]
+                checks.append(f"if {n}.__class__ is not int or not {lo} <= {n} <= {hi}: "
+                              f"{n} = _chi({n}, {where!r}, {t.base!r})")
             body.append(f"self.{n} = {n}")
             eq.append(f"self.{n} == other.{n}")
             continue
         params.append(f"{n}=None")
         if t.kind == SCALAR:  # nested message
             ns[f"_T{i}"] = get(t.base)
+            checks.append(f"if {n} is not None and not isinstance({n}, _T{i}): _chm({n}, _T{i}, {where!r})")
             body.append(f"self.{n} = _T{i}() if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
         elif t.is_primitive:
@@ -242,9 +340,9 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
             else:
                 fresh = f"_empty(0, _D{i})"
             if t.kind == ARRAY:
-                conv = f"_farr({n}, _D{i}, {t.count}, {where!r})"
+                conv = f"_farr({n}, _D{i}, {t.count}, {where!r}) if _t else _cfarr({n}, _D{i}, {t.count}, {where!r})"
             else:
-                conv = f"_arr({n}, _D{i})"
+                conv = f"_arr({n}, _D{i}) if _t else _carr({n}, _D{i}, {where!r})"
             body.append(f"self.{n} = {fresh} if {n} is None else {conv}")
             eq.append(f"_aeq(self.{n}, other.{n})")
         elif t.is_string:
@@ -254,11 +352,13 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
                 fresh = f"[''] * {t.count}"
             else:
                 fresh = "[]"
+            checks.append(f"if {n} is not None: {n} = _chl({n}, str, {where!r}, 'str')")
             body.append(f"self.{n} = {fresh} if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
         else:  # arrays and sequences of messages
             ns[f"_T{i}"] = get(t.base)
             fresh = f"[_T{i}() for _ in range({t.count})]" if t.kind == ARRAY else "[]"
+            checks.append(f"if {n} is not None: {n} = _chl({n}, _T{i}, {where!r}, {t.base!r})")
             body.append(f"self.{n} = {fresh} if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
     freeze = ["def _fz(m, F):", "    if m._frozen:", "        return m", "    c = _new(F[_Self])"]
@@ -289,7 +389,8 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
     ]
     lines += [f"    {c.name} = {c.value!r}" for c in spec.constants]
     lines += [
-        f"    def __init__(self, {', '.join(params)}):",
+        f"    def __init__(self, {', '.join([*params, '_t=False'])}):",
+        *(["        if not _t:"] + [f"            {c}" for c in checks] if checks else []),
         *(f"        {b}" for b in body),
         "    def __eq__(self, other):",
         "        if getattr(other.__class__, '_base', None) is not self._base:",
@@ -323,13 +424,15 @@ def _copy_expr(spec: MsgSpec, cls_name: str, src: str, ns: dict[str, Any],
             args.append(f"_FL({ref})")
         else:
             args.append(f"_FL([x._cp(x) for x in {ref}])")
-    return f"{cls_name}({', '.join(args)})"
+    return f"{cls_name}({', '.join([*args, 'True'])})"
 
 
 def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> type:
     ns: dict[str, Any] = {
         "_Message": Message, "_zeros": np.zeros, "_empty": np.empty, "_arr": as_array,
-        "_farr": as_fixed_array, "_aeq": np.array_equal,
+        "_farr": as_fixed_array, "_aeq": np.array_equal, "_chf": check_float, "_chi": check_int,
+        "_chb": check_bool, "_chs": check_str, "_chm": check_message, "_chl": check_list,
+        "_carr": checked_array, "_cfarr": checked_fixed_array,
     }
     source, freeze = _class_source(spec, ns, get)
     code = compile(source, f"<aiorobot.msgs {spec.name}>", "exec")
