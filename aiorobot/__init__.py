@@ -64,6 +64,7 @@ _EXPORTS = {
     "ParameterType": "_parameters",
     "Publisher": "_pubsub",
     "QoSIncompatibleError": "_errors",
+    "QoSPresetProfiles": "_qos",
     "QoSProfile": "_qos",
     "Rate": "_timer",
     "ReentrantCallbackGroup": "_groups",
@@ -135,6 +136,7 @@ __all__ = [
     "ParameterType",
     "Publisher",
     "QoSIncompatibleError",
+    "QoSPresetProfiles",
     "QoSProfile",
     "ROSClock",
     "Rate",
@@ -177,7 +179,7 @@ if TYPE_CHECKING:
     from ._node import Node
     from ._parameters import FloatingPointRange, IntegerRange, Parameter, ParameterDescriptor, ParameterType, SetParametersResult
     from ._pubsub import MessageStream, Publisher, Subscription
-    from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default
+    from ._qos import DurabilityPolicy, HistoryPolicy, QoSPresetProfiles, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default
     from ._runtime import Runtime, run
     from ._services import Client, Service, ServiceUnavailableError
     from ._time import ClockType, Duration, Infinite, Time

@@ -39,6 +39,10 @@ class Incompatibility:
     reason: str
     publisher_node: str = ""
     subscription_node: str = ""
+    kind: str = "incompatible QoS"  # or "type mismatch"
+
+    def __str__(self) -> str:
+        return f"{self.kind} on {self.topic}: {self.publisher} does not connect to {self.subscription} ({self.reason})"
 
 
 @dataclass
@@ -69,14 +73,20 @@ class Bus:
     @staticmethod
     def _why_not(pub: Publisher, sub: Sub) -> str | None:
         if pub.type_name != sub.type_name:
-            return f"type: publisher sends {pub.type_name}, subscription expects {sub.type_name}"
+            return f"publisher sends {pub.type_name}, subscription expects {sub.type_name}"
         return incompatibility(pub.qos, sub.qos)
 
+    @staticmethod
+    def _kind(pub: Publisher, sub: Sub) -> str:
+        return "type mismatch" if pub.type_name != sub.type_name else "incompatible QoS"
+
+    @classmethod
+    def incompatibility(cls, pub: Publisher, sub: Sub, reason: str) -> Incompatibility:
+        return Incompatibility(pub.topic_name, pub.describe(), sub.describe(), reason, pub.node_name,
+                               sub.node_name, cls._kind(pub, sub))
+
     def _report(self, topic: _Topic, pub: Publisher, sub: Sub, reason: str) -> None:
-        text = (
-            f"incompatible QoS on {topic.name}: {pub.describe()} does not connect to "
-            f"{sub.describe()} ({reason})"
-        )
+        text = str(self.incompatibility(pub, sub, reason))
         if self.strict_qos:
             raise QoSIncompatibleError(text)
         _log.warning(text)
@@ -106,6 +116,7 @@ class Bus:
             if self.debug_messages:
                 if isinstance(endpoint, Publisher):
                     endpoint._guard = PublishGuard()
+                    endpoint._freeze = getattr(endpoint.msg_type, "_fz", None)  # read-only twins
                 elif isinstance(endpoint, Subscription):
                     endpoint._debug = True
             if isinstance(endpoint, Publisher):
@@ -224,7 +235,7 @@ class Bus:
     def incompatibilities(self) -> list[Incompatibility]:
         with self._lock:
             return [
-                Incompatibility(t.name, p.describe(), s.describe(), r, p.node_name, s.node_name)
+                self.incompatibility(p, s, r)
                 for t in self._topics.values()
                 for p, s, r in t.incompatible
                 if not (_hidden(p) or _hidden(s))

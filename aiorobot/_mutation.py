@@ -1,8 +1,11 @@
 """``Runtime(debug_messages=True)``: checks of the zero-copy contract.
 
-In-process delivery hands every subscriber the very object that was published,
-so neither a publisher (after ``publish``) nor a subscriber may change it. With
-debug checks on, a publisher re-checks its last few messages each time it
+``publish`` hands subscribers one copy whose large arrays are shared read-only
+with the publisher (see ``aiorobot._pubsub``); with debug checks on that copy is
+a read-only twin (every assignment raises). What the flags cannot stop is a
+write through another view of a shared buffer (a driver refilling the frame an
+Image's data is a view of) or a callback that sets an array writeable again. So
+a publisher re-checks the copies of its last few messages each time it
 publishes, and a subscription checks that its callback left the message as it
 found it; a change is logged as an error naming the topic and the node. The
 checks pickle messages, so they are for development, not production.

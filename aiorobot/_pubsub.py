@@ -1,7 +1,22 @@
 """Publishers and subscriptions of the in-process bus.
 
-Delivery is zero-copy: every subscription receives the very object that was
-published, so a publisher must not mutate a message after ``publish``.
+``publish`` hands subscribers a copy of the message made at publish, so a
+publisher may change and publish its message again (the rclpy habit):
+
+- scalar fields and nested messages are copied (about what constructing the
+  message costs: ~1 us for a Twist);
+- numpy arrays of at least ``SHARE_BYTES`` (4 KiB) are shared, not copied, and
+  made read-only, the publisher's array too (an Image or PointCloud2 stays
+  zero-copy; writing to the array after publish raises numpy's read-only error);
+  smaller arrays are copied and read-only;
+- sequences of strings and of messages become lists that refuse changes.
+
+Every subscriber of one publish shares that one copy. What is enforced by
+default: read-only arrays and sequences. Scalar fields and nested messages of a
+received message can still be assigned; with ``Runtime(debug_messages=True)``
+subscribers get a read-only twin instead, whose every assignment raises
+``ReadOnlyMessageError`` naming the topic (and the deeper checks of
+``aiorobot._mutation`` run).
 A subscription owns a queue bounded by its QoS history (KEEP_LAST drops the
 oldest when full) and one dispatcher task on its node's loop; messages from
 another loop arrive through ``call_soon_threadsafe``.
@@ -17,6 +32,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from ._mutation import PublishGuard, digest
+from .msgs._classgen import freezer
 from ._qos import DurabilityPolicy, QoSProfile
 
 if TYPE_CHECKING:
@@ -77,6 +93,8 @@ class Publisher(Endpoint, Generic[M]):
         self._taps: tuple[Tap, ...] = ()
         self._thread_id: int | None = None
         self._guard: PublishGuard | None = None  # Runtime(debug_messages=True)
+        self._freeze = getattr(msg_type, "_cp", None)  # generated message classes only
+        self._frozen_classes = freezer(topic)
         self.published = 0
 
     def __repr__(self) -> str:
@@ -111,7 +129,15 @@ class Publisher(Endpoint, Generic[M]):
         self._taps = tuple(taps)
 
     def publish(self, msg: M) -> None:
-        """Hand ``msg`` to every matched subscription. Do not mutate ``msg`` afterwards."""
+        """Hand a copy of ``msg`` (large arrays shared read-only) to every matched subscription.
+
+        ``msg`` stays the caller's to change and publish again, except its numpy arrays of
+        ``SHARE_BYTES`` or more, which subscribers share: those become read-only (assign a
+        new array instead).
+
+        rclpy difference: subscribers of one publish share one copy, whose arrays and
+        sequences are read-only (docs/rclpy-differences.md).
+        """
         if not isinstance(msg, self.msg_type):
             raise TypeError(
                 f"publisher on {self.topic_name} expects {self.type_name}, got {type(msg).__name__}: {msg!r}"
@@ -119,10 +145,12 @@ class Publisher(Endpoint, Generic[M]):
         if self.destroyed:
             raise RuntimeError(f"{self!r} was destroyed")
         self.published += 1
+        if self._freeze is not None and (self._subs or self._history is not None):
+            msg = self._freeze(msg, self._frozen_classes)
         if self._guard is not None and not self._guard.check(msg):
             self.node.get_logger().error(
-                f"debug_messages: a message published on {self.topic_name} was changed after publish; "
-                "subscribers receive the very object, so publish a new message each time",
+                f"debug_messages: a message published on {self.topic_name} was changed after publish "
+                "(through an array it shares with subscribers); publish a new array each time",
                 throttle_duration_sec=1.0,
             )
         if self._history is not None:

@@ -283,21 +283,14 @@ class Runtime:
         """
         pubs = [p for n in nodes for p in n._publishers]
         subs = [s for n in nodes for s in n._subscriptions]
-        return [
-            Incompatibility(p.topic_name, p.describe(), s.describe(), reason, p.node_name, s.node_name)
-            for p, s, reason in self._bus.preview(pubs, subs)
-        ]
+        return [self._bus.incompatibility(p, s, reason) for p, s, reason in self._bus.preview(pubs, subs)]
 
     def add_nodes(self, nodes: list[tuple[Node, str]]) -> None:
         """Add several ``(node, executor)`` pairs; under ``strict_qos`` all or none."""
         if self.strict_qos:
             problems = self.check_qos([node for node, _ in nodes])
             if problems:
-                bad = problems[0]
-                raise QoSIncompatibleError(
-                    f"incompatible QoS on {bad.topic}: {bad.publisher} does not connect to "
-                    f"{bad.subscription} ({bad.reason})"
-                )
+                raise QoSIncompatibleError(str(problems[0]))
         for node, executor in nodes:
             self.add_node(node, executor=executor)
 

@@ -162,8 +162,7 @@ async def _serve(
                 raise ConfigError(
                     config.path,
                     config.nodes[index].key,
-                    f"runtime.strict_qos is set and incompatible QoS on {problem.topic}: "
-                    f"{problem.publisher} does not connect to {problem.subscription} ({problem.reason})",
+                    f"runtime.strict_qos is set and {problem}",
                 )
         rt.add_nodes(nodes)
         display = StatusDisplay(

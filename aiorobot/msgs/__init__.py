@@ -16,7 +16,7 @@ package module costs next to nothing.
 from __future__ import annotations
 
 from ._cdr import DeserializationError, SerializationError, deserialize, serialize
-from ._classgen import Action, Message, Service
+from ._classgen import Action, Message, ReadOnlyMessageError, Service
 from ._describe import message_definition, type_hash
 from ._registry import get, register_action, register_file, register_msg, register_srv
 
@@ -24,6 +24,7 @@ __all__ = [
     "Action",
     "DeserializationError",
     "Message",
+    "ReadOnlyMessageError",
     "SerializationError",
     "Service",
     "deserialize",

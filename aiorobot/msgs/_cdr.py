@@ -55,7 +55,9 @@ def serialize(msg: Any) -> bytes:
                             f"{cls.__name__} {msg!r:.80}")
         from ._cdr_gen import build_serializer  # code generation is loaded on first use
 
-        fn = _SER[cls] = build_serializer(cls)
+        base = cls._base  # a delivered (read-only) message encodes as its mutable class
+        fn = _SER.get(base) or build_serializer(base)
+        _SER[cls] = _SER[base] = fn
     try:
         return fn(msg)
     except _SER_ERRORS as exc:

@@ -13,19 +13,30 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ._spec import ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
+from ._spec import _INT_RANGES, ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
 
-__all__ = ["Action", "Message", "Service", "build_class"]
+__all__ = ["Action", "FrozenList", "Message", "ReadOnlyMessageError", "Service", "build_class",
+           "freezer"]
 
 _ndarray = np.ndarray
 
 
 class Message:
-    """Base class of every generated message class."""
+    """Base class of every generated message class.
+
+    Constructor arguments are checked as rclpy's generated classes check them: type, integer
+    and float32 range, string bounds, item types of sequences; a bad one raises TypeError or
+    ValueError naming the field. Assignments after construction are not checked.
+
+    rclpy difference: float fields accept ints and numpy numbers (stored as float); rclpy
+    accepts only float. Assignment is not checked (rclpy checks every assignment).
+    """
 
     __slots__ = ()
     __msgtype__: ClassVar[str] = ""
     _field_types: ClassVar[dict[str, str]] = {}
+    _base: ClassVar[type[Message]]  # the generated class itself; read-only twins inherit it
+    _frozen: ClassVar[bool] = False  # True on the read-only twins that subscribers receive
 
     @classmethod
     def get_fields_and_field_types(cls) -> dict[str, str]:
@@ -35,9 +46,103 @@ class Message:
     def __reduce__(self) -> tuple[Any, ...]:
         from ._registry import rebuild
 
-        return rebuild, (self.__msgtype__, tuple(getattr(self, n) for n in self.__slots__))
+        return rebuild, (self.__msgtype__, tuple(getattr(self, n) for n in self._base.__slots__))
+
+    def copy(self) -> Any:
+        """A deep, mutable copy (numpy arrays copied): what to change instead of a received message."""
+        import copy
+
+        return copy.deepcopy(self)
 
     __hash__ = None  # type: ignore[assignment]  # mutable, compared by value
+
+
+#: Arrays of at least this many bytes are shared (made read-only) at publish; smaller ones are copied.
+SHARE_BYTES = 4096
+
+
+class ReadOnlyMessageError(AttributeError):
+    """Raised on an attempt to change a message as delivered to subscribers."""
+
+
+class FrozenList(list):  # type: ignore[type-arg]
+    """A list that refuses changes: the sequence fields of a delivered message."""
+
+    __slots__ = ()
+
+    def _refuse(self, *_args: Any, **_kwargs: Any) -> Any:
+        raise ReadOnlyMessageError("this list belongs to a published message; copy it with list(...) "
+                                   "or copy the message with .copy()")
+
+    append = extend = insert = remove = pop = clear = sort = reverse = _refuse
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = _refuse
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return list, (list(self),)
+
+    def __copy__(self) -> list[Any]:
+        return list(self)
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> list[Any]:
+        import copy
+
+        return [copy.deepcopy(x, memo) for x in self]
+
+
+def _readonly_array(a: np.ndarray) -> np.ndarray:
+    """What a subscriber gets for an array field: large ones shared, small ones copied; both read-only."""
+    if not a.flags.writeable:
+        return a
+    if a.nbytes >= SHARE_BYTES:
+        a.flags.writeable = False  # the publisher's array too: a write after publish raises
+        return a
+    b = a.copy()
+    b.flags.writeable = False
+    return b
+
+
+class _Freezer(dict):  # type: ignore[type-arg]
+    """Message class -> its read-only twin for one topic (created on first use)."""
+
+    def __init__(self, topic: str) -> None:
+        super().__init__()
+        self.topic = topic
+
+    def __missing__(self, cls: type) -> type:
+        twin = self[cls] = _frozen_twin(cls, self.topic)
+        return twin
+
+
+_FREEZERS: dict[str, _Freezer] = {}
+
+
+def freezer(topic: str) -> _Freezer:
+    """The shared class table of read-only twins for messages published on ``topic``."""
+    f = _FREEZERS.get(topic)
+    if f is None:
+        f = _FREEZERS[topic] = _Freezer(topic)
+    return f
+
+
+def _frozen_twin(cls: type, topic: str) -> type:
+    short = cls.__name__
+    text = (f"this {short} was published on {topic}; publish a new one or .copy() it "
+            "(subscribers share what was published)")
+
+    def __setattr__(self: Any, name: str, value: Any) -> None:
+        raise ReadOnlyMessageError(text)
+
+    def __delattr__(self: Any, name: str) -> None:
+        raise ReadOnlyMessageError(text)
+
+    def __new__(twin: type, *args: Any, **kwargs: Any) -> Any:
+        return cls(*args, **kwargs)  # type(received)(...) builds a mutable message
+
+    twin = type(cls)(short, (cls,), {"__slots__": (), "__setattr__": __setattr__,
+                                      "__delattr__": __delattr__, "__new__": __new__,
+                                      "_frozen": True, "__module__": cls.__module__})
+    twin.__qualname__ = cls.__qualname__
+    return twin
 
 
 class _InterfaceMeta(type):
@@ -105,6 +210,82 @@ def as_fixed_array(value: Any, dtype: np.dtype[Any], count: int, where: str) -> 
     return arr
 
 
+_F32_MAX = 3.4028234663852886e38
+
+
+def _got(value: Any) -> str:
+    return f"{type(value).__name__} {value!r:.60}"
+
+
+def check_float(value: Any, where: str, base: str) -> float:
+    """A float field's value: floats, ints and numpy numbers (as float); else TypeError."""
+    if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        value = float(value)
+    else:
+        raise TypeError(f"{where} expects a float ({base}), got {_got(value)}")
+    if base == "float32" and abs(value) > _F32_MAX and value == value and abs(value) != float("inf"):
+        raise ValueError(f"{where}: {value!r} is out of range for float32")
+    return value
+
+
+def check_int(value: Any, where: str, base: str) -> int:
+    """An integer field's value: ints (and bools, numpy integers) in the type's range."""
+    if isinstance(value, (int, np.integer)):
+        value = int(value)
+    else:
+        raise TypeError(f"{where} expects an int ({base}), got {_got(value)}")
+    lo, hi = _INT_RANGES[base]
+    if not lo <= value <= hi:
+        raise ValueError(f"{where}: {value} is out of range for {base} [{lo}, {hi}]")
+    return value
+
+
+def check_bool(value: Any, where: str) -> bool:
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{where} expects a bool, got {_got(value)}")
+
+
+def check_str(value: Any, where: str, bound: int) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{where} expects a str, got {_got(value)}")
+    if bound and len(value) > bound:
+        raise ValueError(f"{where} is bounded to {bound} characters, got {len(value)}")
+    return str(value)
+
+
+def check_message(value: Any, cls: type, where: str) -> Any:
+    if not isinstance(value, cls):
+        raise TypeError(f"{where} expects a {cls.__msgtype__} message, got {_got(value)}")  # type: ignore[attr-defined]
+    return value
+
+
+def check_list(value: Any, item: Any, where: str, what: str) -> list[Any]:
+    """A sequence field of strings or messages: a list (or tuple) whose items are ``item``."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{where} expects a list of {what}, got {_got(value)}")
+    value = value if isinstance(value, list) else list(value)
+    for i, x in enumerate(value):
+        if not isinstance(x, item):
+            raise TypeError(f"{where}[{i}] expects a {what}, got {_got(x)}")
+    return value  # type: ignore[no-any-return]
+
+
+def checked_array(value: Any, dtype: np.dtype[Any], where: str) -> np.ndarray:
+    try:
+        return as_array(value, dtype)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise (TypeError if isinstance(exc, TypeError) else ValueError)(
+            f"{where} expects a sequence of {dtype.name}: {exc}") from None
+
+
+def checked_fixed_array(value: Any, dtype: np.dtype[Any], count: int, where: str) -> np.ndarray:
+    arr = checked_array(value, dtype, where)
+    if arr.shape[0] != count:
+        raise ValueError(f"{where} is a fixed array of {count} elements, got {arr.shape[0]}")
+    return arr
+
+
 def _zero_literal(base: str) -> str:
     if base == "bool":
         return "False"
@@ -118,6 +299,7 @@ def _zero_literal(base: str) -> str:
 def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type]) -> str:
     names = [f.name for f in spec.fields]
     params: list[str] = []
+    checks: list[str] = []  # skipped when _t (a copy made by _cp from a checked message)
     body: list[str] = []
     eq: list[str] = []
     for i, f in enumerate(spec.fields):
@@ -127,12 +309,25 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
         if t.kind == SCALAR and not t.is_message:
             default = repr(f.default) if f.default is not None else _zero_literal(t.base)
             params.append(f"{n}={default}")
+            if t.base in ("float32", "float64"):
+                lim = "" if t.base == "float64" else f" or not -{_F32_MAX!r} <= {n} <= {_F32_MAX!r}"
+                checks.append(f"if {n}.__class__ is not float{lim}: {n} = _chf({n}, {where!r}, {t.base!r})")
+            elif t.base == "bool":
+                checks.append(f"if {n}.__class__ is not bool: {n} = _chb({n}, {where!r})")
+            elif t.is_string:
+                lim = f" or len({n}) > {t.string_bound}" if t.string_bound else ""
+                checks.append(f"if {n}.__class__ is not str{lim}: {n} = _chs({n}, {where!r}, {t.string_bound})")
+            else:
+                lo, hi = _INT_RANGES[t.base]
+                checks.append(f"if {n}.__class__ is not int or not {lo} <= {n} <= {hi}: "
+                              f"{n} = _chi({n}, {where!r}, {t.base!r})")
             body.append(f"self.{n} = {n}")
             eq.append(f"self.{n} == other.{n}")
             continue
         params.append(f"{n}=None")
         if t.kind == SCALAR:  # nested message
             ns[f"_T{i}"] = get(t.base)
+            checks.append(f"if {n} is not None and not isinstance({n}, _T{i}): _chm({n}, _T{i}, {where!r})")
             body.append(f"self.{n} = _T{i}() if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
         elif t.is_primitive:
@@ -145,9 +340,9 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
             else:
                 fresh = f"_empty(0, _D{i})"
             if t.kind == ARRAY:
-                conv = f"_farr({n}, _D{i}, {t.count}, {where!r})"
+                conv = f"_farr({n}, _D{i}, {t.count}, {where!r}) if _t else _cfarr({n}, _D{i}, {t.count}, {where!r})"
             else:
-                conv = f"_arr({n}, _D{i})"
+                conv = f"_arr({n}, _D{i}) if _t else _carr({n}, _D{i}, {where!r})"
             body.append(f"self.{n} = {fresh} if {n} is None else {conv}")
             eq.append(f"_aeq(self.{n}, other.{n})")
         elif t.is_string:
@@ -157,13 +352,33 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
                 fresh = f"[''] * {t.count}"
             else:
                 fresh = "[]"
+            checks.append(f"if {n} is not None: {n} = _chl({n}, str, {where!r}, 'str')")
             body.append(f"self.{n} = {fresh} if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
         else:  # arrays and sequences of messages
             ns[f"_T{i}"] = get(t.base)
             fresh = f"[_T{i}() for _ in range({t.count})]" if t.kind == ARRAY else "[]"
+            checks.append(f"if {n} is not None: {n} = _chl({n}, _T{i}, {where!r}, {t.base!r})")
             body.append(f"self.{n} = {fresh} if {n} is None else {n}")
             eq.append(f"self.{n} == other.{n}")
+    freeze = ["def _fz(m, F):", "    if m._frozen:", "        return m", "    c = _new(F[_Self])"]
+    for i, f in enumerate(spec.fields):
+        t = f.type
+        n = f.name
+        if t.kind == SCALAR and not t.is_message:
+            freeze.append(f"    _S{i}(c, m.{n})")
+        elif t.kind == SCALAR:
+            freeze.append(f"    _S{i}(c, _T{i}._fz(m.{n}, F))")
+        elif t.is_primitive:
+            freeze.append(f"    _S{i}(c, _ro(m.{n}))")
+        elif t.is_string:
+            freeze.append(f"    _S{i}(c, _FL(m.{n}))")
+        else:
+            freeze.append(f"    _S{i}(c, _FL([x._fz(x, F) for x in m.{n}]))")
+    freeze.append("    return c")
+    binds: list[str] = []
+    expr = _copy_expr(spec, "_Self", "m", ns, get, binds)
+    freeze += ["def _cp(m, F=None):", *(f"    {b}" for b in binds), f"    return {expr}"]
     dotted = spec.name.replace("/", ".")
     reprs = ", ".join(f"{n}={{self.{n}!r}}" for n in names)
     lines = [
@@ -174,27 +389,62 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
     ]
     lines += [f"    {c.name} = {c.value!r}" for c in spec.constants]
     lines += [
-        f"    def __init__(self, {', '.join(params)}):",
+        f"    def __init__(self, {', '.join([*params, '_t=False'])}):",
+        *(["        if not _t:"] + [f"            {c}" for c in checks] if checks else []),
         *(f"        {b}" for b in body),
         "    def __eq__(self, other):",
-        "        if other.__class__ is not self.__class__:",
+        "        if getattr(other.__class__, '_base', None) is not self._base:",
         "            return NotImplemented",
         f"        return bool({' and '.join(eq)})",
         "    def __repr__(self):",
         f"        return f'{dotted}({reprs})'",
     ]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n", "\n".join(freeze) + "\n"
+
+
+def _copy_expr(spec: MsgSpec, cls_name: str, src: str, ns: dict[str, Any],
+               get: Callable[[str], type], binds: list[str]) -> str:
+    """One expression building a copy of ``src``, nested messages inlined (their sources bound
+    to locals in ``binds``): scalars shared, arrays through ``_ro``, sequences as FrozenList."""
+    args = []
+    for f in spec.fields:
+        t = f.type
+        ref = f"{src}.{f.name}"
+        if t.kind == SCALAR and not t.is_message:
+            args.append(ref)
+        elif t.kind == SCALAR:
+            k = len(binds) + 1
+            nested = get(t.base)
+            ns[f"_C{k}"] = nested
+            binds.append(f"_v{k} = {ref}")
+            args.append(_copy_expr(nested._spec, f"_C{k}", f"_v{k}", ns, get, binds))  # type: ignore[attr-defined]
+        elif t.is_primitive:
+            args.append(f"_ro({ref})")
+        elif t.is_string:
+            args.append(f"_FL({ref})")
+        else:
+            args.append(f"_FL([x._cp(x) for x in {ref}])")
+    return f"{cls_name}({', '.join([*args, 'True'])})"
 
 
 def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> type:
     ns: dict[str, Any] = {
         "_Message": Message, "_zeros": np.zeros, "_empty": np.empty, "_arr": as_array,
-        "_farr": as_fixed_array, "_aeq": np.array_equal,
+        "_farr": as_fixed_array, "_aeq": np.array_equal, "_chf": check_float, "_chi": check_int,
+        "_chb": check_bool, "_chs": check_str, "_chm": check_message, "_chl": check_list,
+        "_carr": checked_array, "_cfarr": checked_fixed_array,
     }
-    source = _class_source(spec, ns, get)
+    source, freeze = _class_source(spec, ns, get)
     code = compile(source, f"<aiorobot.msgs {spec.name}>", "exec")
     exec(code, ns)  # noqa: S102 - source generated from a validated spec
     cls: type = ns[spec.short_name]
+    ns.update(_Self=cls, _new=object.__new__, _ro=_readonly_array, _FL=FrozenList)
+    ns.update({f"_S{i}": cls.__dict__[f.name].__set__ for i, f in enumerate(spec.fields)})
+    exec(compile(freeze, f"<aiorobot.msgs {spec.name} freeze>", "exec"), ns)  # noqa: S102
+    cls._fz = staticmethod(ns["_fz"])  # type: ignore[attr-defined]
+    cls._cp = staticmethod(ns["_cp"])  # type: ignore[attr-defined]
+    cls._base = cls  # type: ignore[attr-defined]
+    cls._frozen = False  # type: ignore[attr-defined]
     cls.__module__ = f"aiorobot.msgs.{spec.package}"
     cls.__qualname__ = qualname
     cls.__doc__ = f"ROS 2 message {spec.name}."

@@ -29,7 +29,7 @@ async def test_subscriber_receives_the_published_object(runtime):
     msg = String(data="hello")
     pub.publish(msg)
     await settle(runtime)
-    assert got == [msg] and got[0] is msg
+    assert got == [msg] and got[0] is not msg  # a read-only twin: the publisher may reuse msg
 
 
 async def test_async_callbacks_run_in_publish_order(runtime):
@@ -181,8 +181,20 @@ async def test_mismatched_types_do_not_connect(runtime, caplog):
     pub = node.create_publisher(Int32, "/x", 10)
     with caplog.at_level(logging.WARNING, logger="aiorobot.runtime"):
         node.create_subscription(String, "/x", print, 10)
-    assert "type: publisher sends std_msgs/msg/Int32" in caplog.text
+    # issue 18 item 6: said "incompatible QoS" before
+    assert "type mismatch on /x: " in caplog.text and "incompatible QoS" not in caplog.text
+    assert "(publisher sends std_msgs/msg/Int32, subscription expects std_msgs/msg/String)" in caplog.text
     assert pub.get_subscription_count() == 0
+    [problem] = runtime.graph.incompatible_qos
+    assert problem.kind == "type mismatch" and str(problem).startswith("type mismatch on /x: publisher of /n")
+
+
+async def test_mismatched_types_under_strict_qos_say_type_mismatch():
+    async with Runtime(strict_qos=True, handle_signals=False) as rt:
+        node = rt.add_node(Node("n"))
+        node.create_publisher(Int32, "/x", 10)
+        with pytest.raises(QoSIncompatibleError, match="^type mismatch on /x: .*publisher sends std_msgs/msg/Int32"):
+            node.create_subscription(String, "/x", print, 10)
 
 
 async def test_publishing_the_wrong_type_raises(runtime):

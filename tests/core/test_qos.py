@@ -1,15 +1,21 @@
+import warnings
+
 import pytest
 
 from aiorobot import (
     DurabilityPolicy,
     Duration,
     HistoryPolicy,
+    Node,
+    QoSPresetProfiles,
     QoSProfile,
     ReliabilityPolicy,
     qos_profile_sensor_data,
     qos_profile_system_default,
 )
 from aiorobot._qos import incompatibility, to_qos_profile
+from aiorobot.msgs.std_msgs import Int32
+from aiorobot.testing import settle
 
 
 def test_defaults_match_ros2():
@@ -38,10 +44,49 @@ def test_bad_depth_is_rejected(bad):
         QoSProfile(depth=bad) if not isinstance(bad, bool) else to_qos_profile(bad)
 
 
-def test_keep_last_needs_depth_at_least_one():
-    with pytest.raises(ValueError, match="at least 1"):
-        QoSProfile(depth=0)
+def test_keep_last_zero_depth_constructor():
+    # rclpy test/test_qos.py::test_keep_last_zero_depth_constructor (issue 10 item 6: raised before)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", category=UserWarning)
+        qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=0)
+    assert len(caught) == 1 and issubclass(caught[0].category, UserWarning)
+    assert "A zero depth with KEEP_LAST doesn't make sense" in str(caught[0])
+    assert qos.history is HistoryPolicy.KEEP_LAST and qos.depth == 0
+    assert qos.queue_limit == 10  # the system default queue, not none
     assert QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=0).queue_limit is None
+
+
+def test_policy_short_keys():
+    # rclpy test/test_qos.py::test_policy_short_names (the members aiorobot has)
+    assert ReliabilityPolicy.short_keys() == ["reliable", "best_effort"]
+    assert ReliabilityPolicy.get_from_short_key("reliable") == ReliabilityPolicy.RELIABLE.value
+    assert ReliabilityPolicy.get_from_short_key("BEST_effort") == ReliabilityPolicy.BEST_EFFORT.value
+    assert DurabilityPolicy.get_from_short_key("transient_local") == DurabilityPolicy.TRANSIENT_LOCAL.value
+    assert HistoryPolicy.get_from_short_key("KEEP_ALL") == HistoryPolicy.KEEP_ALL.value
+    assert HistoryPolicy.get_from_short_key("KEEP_last") == HistoryPolicy.KEEP_LAST.value
+    assert HistoryPolicy.KEEP_LAST.short_key == "keep_last"
+    with pytest.raises(KeyError):
+        ReliabilityPolicy.get_from_short_key("system_default")
+
+
+def test_preset_profiles():
+    # rclpy test/test_qos.py::test_preset_profiles
+    assert QoSPresetProfiles.SYSTEM_DEFAULT.value == qos_profile_system_default
+    assert QoSPresetProfiles.SYSTEM_DEFAULT.value == QoSPresetProfiles.get_from_short_key("system_default")
+    assert QoSPresetProfiles.get_from_short_key("SENSOR_DATA") is qos_profile_sensor_data
+    assert "parameter_events" in QoSPresetProfiles.short_keys()
+    assert QoSPresetProfiles.ACTION_STATUS_DEFAULT.value.durability is DurabilityPolicy.TRANSIENT_LOCAL
+
+
+async def test_zero_depth_keep_last_subscription_receives(runtime):
+    got = []
+    node = runtime.add_node(Node("n"))
+    with pytest.warns(UserWarning, match="zero depth"):
+        qos = QoSProfile(depth=0)
+    node.create_subscription(Int32, "/x", got.append, qos)
+    node.create_publisher(Int32, "/x", 10).publish(Int32(data=1))
+    await settle(runtime)
+    assert [m.data for m in got] == [1]
 
 
 def test_policies_accept_rmw_integers():

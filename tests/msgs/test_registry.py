@@ -146,7 +146,10 @@ def test_register_msg_makes_the_type_usable() -> None:
     assert msgs.deserialize(msgs.serialize(sample), "test_registry_msgs/msg/Sample") == sample
     assert msgs.type_hash(cls).startswith("RIHS01_")
     assert "MSG: test_registry_msgs/Point" in msgs.message_definition(cls)
-    too_long = cls(label="123456789")
+    with pytest.raises(ValueError, match=r"Sample\.label is bounded to 8 characters, got 9"):
+        cls(label="123456789")
+    too_long = cls()
+    too_long.label = "123456789"  # assignment is not checked: the serializer is
     with pytest.raises(msgs.SerializationError, match=r"field 'label' is bounded to 8 characters"):
         msgs.serialize(too_long)
 
