@@ -209,6 +209,7 @@ class Recorder(Node):
                 put((name, clock.now().nanoseconds, serialize(msg)))
 
             tap = Tap(msg_type, name, qos, record, owner=self.get_fully_qualified_name())
+            tap.node, tap.wants_remote = self, True  # also receives remote publishers over a transport
             self._taps[name] = tap
         self.runtime._bus.add_subscription(tap)
         if durability is DurabilityPolicy.TRANSIENT_LOCAL:

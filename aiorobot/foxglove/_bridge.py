@@ -189,6 +189,7 @@ class FoxgloveBridge(Node):
 
             qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, durability=endpoint.qos.durability, depth=max(1, endpoint.qos.depth))
             tap = Tap(endpoint.msg_type, name, qos, forward, owner=self.get_fully_qualified_name())
+            tap.node, tap.wants_remote = self, True  # also receives remote publishers over a transport
             self._taps.append(tap)
         self.runtime._bus.add_subscription(tap)
 

@@ -547,12 +547,12 @@ class ZenohTransport(Transport):
     # -- local endpoints ------------------------------------------------------------------
 
     def endpoint_added(self, endpoint: Any) -> None:
-        if self._session is None or isinstance(endpoint, (_Injector, Tap)):
+        if self._session is None or isinstance(endpoint, _Injector) or _own_tap(endpoint):
             return
         with self._lock:
             if isinstance(endpoint, Publisher):
                 self._add_publisher(endpoint)
-            elif isinstance(endpoint, Subscription):
+            elif isinstance(endpoint, (Subscription, Tap)):  # a Tap here is a recorder's or a bridge's
                 self._add_subscription(endpoint)
             elif isinstance(endpoint, Service):
                 self._add_service(endpoint)
@@ -562,7 +562,7 @@ class ZenohTransport(Transport):
                 )
 
     def endpoint_removed(self, endpoint: Any) -> None:
-        if self._session is None or isinstance(endpoint, (_Injector, Tap)):
+        if self._session is None or isinstance(endpoint, _Injector) or _own_tap(endpoint):
             return
         with self._lock:
             self._drop_token(endpoint)
@@ -575,7 +575,7 @@ class ZenohTransport(Transport):
                         if self.bus is not None:
                             self.bus.remove(out.tap)
                         out.close()
-            elif isinstance(endpoint, Subscription):
+            elif isinstance(endpoint, (Subscription, Tap)):
                 inb = self._inbound.get((endpoint.topic_name, endpoint.type_name))
                 if inb is not None and endpoint in inb.subscriptions:
                     inb.subscriptions.remove(endpoint)
@@ -842,3 +842,9 @@ class ZenohTransport(Transport):
 
 def _ignore(_msg: Any) -> None:
     """A remote subscription's tap: the sender tap of the topic does the sending."""
+
+
+def _own_tap(endpoint: Any) -> bool:
+    """A tap that is not a subscriber of remote data (the transport's own outbound taps, the
+    runtime's /clock tap): recorders and bridges mark theirs with ``wants_remote`` and a node."""
+    return isinstance(endpoint, Tap) and not (getattr(endpoint, "wants_remote", False) and endpoint.node is not None)
