@@ -368,3 +368,17 @@ def test_on_a_terminal_the_status_is_a_live_display_and_exits_cleanly() -> None:
     assert_clean(output)
     assert "\x1b[?25l" in output, "rich hides the cursor while the Live display runs"
     assert "imu_monitor: received" in output
+
+
+def test_ctrl_c_while_a_command_starts_is_one_line_and_status_130(monkeypatch, capsys) -> None:
+    """Ctrl-C during the first fraction of a second (imports, start-up): no traceback."""
+    import importlib
+
+    from aiorobot import cli
+
+    def interrupted(name: str):  # the KeyboardInterrupt a Ctrl-C raises inside an import
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(importlib, "import_module", interrupted)
+    assert cli.main(["run"]) == 130
+    assert capsys.readouterr().err == "aiorobot: interrupted\n"

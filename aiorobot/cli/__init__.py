@@ -35,7 +35,19 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``aiorobot`` console script; returns the exit status."""
+    """Entry point of the ``aiorobot`` console script; returns the exit status.
+
+    Ctrl-C while a command is still importing or starting ends with one line and status 130,
+    not a traceback through the import machinery.
+    """
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("aiorobot: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: Sequence[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = ArgumentParser(
         prog="aiorobot",
