@@ -37,6 +37,7 @@ from ._math import (
 )
 from ._listener import TransformListener
 from ._robot_state_publisher import RobotStatePublisher
+from ._static_publisher import StaticTransformPublisher
 from ._urdf import URDFError, UrdfJoint, UrdfModel, load_urdf, parse_urdf
 from ._views import FrameInfo
 
@@ -50,6 +51,7 @@ __all__ = [
     "LookupException",
     "RobotStatePublisher",
     "StaticTransformBroadcaster",
+    "StaticTransformPublisher",
     "TransformBroadcaster",
     "TransformException",
     "TransformListener",
