@@ -27,3 +27,19 @@ def test_perception_example_maps_the_four_markers():
     assert "Traceback" not in output
     # the ring's segment is gone (at exit the resource tracker would warn about a leaked segment)
     assert "leaked" not in output
+
+
+def test_perception_on_the_simulator_maps_the_marker_in_view():
+    """examples/perception_sim.toml: the simulator's camera through the ArUco worker into the map."""
+    result = subprocess.run(
+        [sys.executable, "-m", "aiorobot.cli", "run", "perception_sim.toml", "--duration", "5"],
+        capture_output=True, text=True, timeout=90, cwd=EXAMPLES,
+    )
+    output = result.stdout + result.stderr
+    assert result.returncode == 0, output
+    found = {int(m[0]): tuple(map(float, m[1:])) for m in
+             re.findall(r"detection map: marker (\d+) at \(([-\d.]+), ([-\d.]+), ([-\d.]+)\) in map", output)}
+    # box world: the robot at the origin facing +x sees marker 0, centred on the x = 3 m wall, 0.25 m up
+    assert set(found) == {0}, output
+    assert max(abs(a - b) for a, b in zip(found[0], (3.0, 0.0, 0.25))) <= 0.03, found
+    assert "Traceback" not in output
