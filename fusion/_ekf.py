@@ -158,6 +158,22 @@ class Ekf:
         x, y, _, _, _, yaw = self.state[:6]
         return f"<Ekf x={x:.3f} y={y:.3f} yaw={yaw:.3f}>"
 
+    @staticmethod
+    def warm_up() -> None:
+        """Load (or compile) the Numba kernels now, in the calling thread.
+
+        A kernel's first call imports Numba and reads its cache, tens of milliseconds; a node
+        calls this at construction so that cost never lands on the loop it runs on (the
+        priority loop, where it would be a stall).
+        """
+        from ._kernels import covariance_status
+
+        ekf = Ekf()
+        ekf.predict(0.01)
+        ekf.update(np.zeros(STATE_SIZE), np.eye(STATE_SIZE), np.ones(STATE_SIZE, dtype=np.bool_))
+        for size in (3, 6):
+            covariance_status(np.eye(size))
+
     def reset(self) -> None:
         """Back to the initial state and covariance."""
         self.state[:] = self._initial_state

@@ -67,6 +67,7 @@ class EkfNode(Node):
         for ignored in sorted(set(given) & set(IGNORED_PARAMETERS)):
             self.declare_parameter(ignored, self._override_type_default(ignored))
             self.get_logger().warning(f"robot_localization parameter {ignored!r} has no effect in aiorobot")
+        Ekf.warm_up()  # Numba's first-call cost here, not on the priority loop at the first message
         self.ekf = Ekf(
             process_noise=p["process_noise_covariance"],
             initial_covariance=p["initial_estimate_covariance"],
