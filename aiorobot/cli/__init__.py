@@ -31,6 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "service": ("aiorobot.cli._service", "services of the running graph: list, call"),
     "action": ("aiorobot.cli._action", "actions of the running graph: list, info, send_goal"),
     "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
+    "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
 }
 
 
