@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "action": ("aiorobot.cli._action", "actions of the running graph: list, info, send_goal"),
     "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
     "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
+    "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
 }
 
 
