@@ -33,6 +33,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
     "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
     "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
+    "tf": ("aiorobot.cli._tf_cmd", "transforms of the running graph: echo (tf2_echo), tree (view_frames)"),
 }
 
 
