@@ -34,6 +34,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
     "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
     "tf": ("aiorobot.cli._tf_cmd", "transforms of the running graph: echo (tf2_echo), tree (view_frames)"),
+    "interface": ("aiorobot.cli._interface_cmd", "message, service and action types: list, packages, package, show"),
 }
 
 
