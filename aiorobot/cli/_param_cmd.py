@@ -134,9 +134,15 @@ async def _list(rt: Any, node: Any, args: argparse.Namespace, regex: re.Pattern[
         services = {s.name for s in rt.graph.services}
         nodes = [n for n in remote_node_names(rt) if f"{n}/list_parameters" in services]
     responses = await asyncio.gather(
-        *(_call(node, n, "list_parameters", args.timeout, prefixes=args.param_prefixes, depth=0) for n in nodes)
+        *(_call(node, n, "list_parameters", args.timeout, prefixes=args.param_prefixes, depth=0) for n in nodes),
+        return_exceptions=len(nodes) > 1,  # listing every node: one that does not answer is reported, not fatal
     )
     for fqn, response in zip(nodes, responses):
+        if isinstance(response, UserError):
+            print(f"aiorobot param list: {fqn}: {response}", file=sys.stderr)
+            continue
+        if isinstance(response, BaseException):
+            raise response
         names = sorted(response.result.names)
         if regex is not None:
             names = [n for n in names if regex.match(n)]
