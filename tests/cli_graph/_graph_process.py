@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 import textwrap
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -27,7 +28,9 @@ class GraphProcess:
         while True:
             line = self.proc.stdout.readline()
             if not line:
-                raise AssertionError(f"graph process exited before printing {prefix!r}: {self.proc.stderr.read()[-2000:]}")  # type: ignore[union-attr]
+                assert self.proc.stderr is not None
+                self.proc.stderr.seek(0)
+                raise AssertionError(f"graph process exited before printing {prefix!r}: {self.proc.stderr.read()[-2000:]}")
             if line.startswith(prefix):
                 return line.rstrip("\n")
 
@@ -45,10 +48,13 @@ def start_graph(code: str) -> Iterator[GraphProcess]:
         """)
     env = dict(os.environ)
     env.pop("ZENOH_CONFIG_OVERRIDE", None)
+    # stderr to a file: a pipe nobody reads would block the child once its logs fill the buffer
+    errors = tempfile.TemporaryFile("w+")
     proc = subprocess.Popen(
-        [sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        [sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=errors,
         text=True, env=env,
     )
+    proc.stderr = errors
     graph = GraphProcess(port, proc)
     try:
         graph.expect("ready")
