@@ -31,6 +31,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "service": ("aiorobot.cli._service", "services of the running graph: list, call"),
     "action": ("aiorobot.cli._action", "actions of the running graph: list, info, send_goal"),
     "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
+    "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
+    "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
+    "tf": ("aiorobot.cli._tf_cmd", "transforms of the running graph: echo (tf2_echo), tree (view_frames)"),
+    "interface": ("aiorobot.cli._interface_cmd", "message, service and action types: list, packages, package, show"),
 }
 
 

@@ -12,7 +12,18 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["UserError", "add_graph_options", "fill_message", "join_graph", "message_to_yaml", "to_plain"]
+__all__ = [
+    "UserError",
+    "add_graph_options",
+    "call_service",
+    "cli_node",
+    "fill_message",
+    "join_graph",
+    "message_to_yaml",
+    "remote_node_names",
+    "resolve_node",
+    "to_plain",
+]
 
 #: Discovery is complete once no liveliness token has arrived for this long.
 QUIET_SEC = 0.15
@@ -54,6 +65,45 @@ async def settle_discovery(transport: Any) -> None:
             seen, last_change = now_seen, time.monotonic()
         elif time.monotonic() - last_change >= QUIET_SEC:
             return
+
+
+def remote_node_names(rt: Any) -> list[str]:
+    """Fully qualified names of the graph's nodes, the command's own left out, sorted."""
+    own = {n.get_fully_qualified_name() for n in rt.nodes}
+    return sorted({n.fully_qualified_name for n in rt.graph.nodes} - own)
+
+
+def resolve_node(rt: Any, name: str) -> str:
+    """``name`` as a fully qualified node name of the graph, or a UserError naming it."""
+    fqn = name if name.startswith("/") else "/" + name
+    if fqn not in remote_node_names(rt):
+        raise UserError(f"unknown node {name!r}; 'aiorobot node list' shows the nodes")
+    return fqn
+
+
+def cli_node(rt: Any, name: str) -> Any:
+    """The command's own node (no parameter services of its own), created once per runtime."""
+    from .. import Node
+
+    for node in rt.nodes:
+        if node.get_name() == name:
+            return node
+    return rt.add_node(Node(name, start_parameter_services=False))
+
+
+async def call_service(node: Any, srv_type: Any, name: str, request: Any, timeout_sec: float) -> Any:
+    """One call of service ``name``; a UserError when no server answers within ``timeout_sec``."""
+    from .. import ServiceError
+
+    client = node.create_client(srv_type, name)
+    try:
+        if not await client.wait_for_service(timeout_sec=timeout_sec):
+            raise UserError(f"no server for {name} [{srv_type.__msgtype__}] within {timeout_sec} s")
+        return await client.call(request, timeout_sec=timeout_sec)
+    except (ServiceError, TimeoutError) as err:
+        raise UserError(f"{name}: {err or 'no response within ' + str(timeout_sec) + ' s'}") from None
+    finally:
+        node.destroy_client(client)
 
 
 def to_plain(msg: Any) -> Any:

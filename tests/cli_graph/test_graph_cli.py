@@ -57,7 +57,7 @@ async def cli(port: int, *argv: str) -> tuple[int, str, str]:
     return proc.returncode or 0, out.decode(), err.decode()
 
 
-async def test_topic_node_service_and_graph_commands_see_the_other_process(graph_port) -> None:  # type: ignore[no-untyped-def]
+async def test_topic_node_service_and_graph_commands_see_the_other_process(graph_port, tmp_path) -> None:  # type: ignore[no-untyped-def]
     port, child = graph_port
     code, out, err = await cli(port, "topic", "list", "-t")
     assert code == 0, err
@@ -98,6 +98,13 @@ async def test_topic_node_service_and_graph_commands_see_the_other_process(graph
     code, out, err = await cli(port, "graph", "--dot")
     assert code == 0, err
     assert '"/robot/talker" -> "/chatter";' in out
+
+    page = tmp_path / "graph.html"
+    code, out, err = await cli(port, "graph", "--html", str(page))
+    assert code == 0, err
+    html = page.read_text()
+    assert html.startswith("<!DOCTYPE html>") and '<g class="node" data-name="/robot/talker">' in html
+    assert 'data-from="/robot/talker" data-to="/chatter"' in html and 'data-from="/cmd_vel" data-to="/robot/talker"' in html
 
 
 async def test_topic_pub_with_yaml_that_does_not_fit_the_type_names_the_field(graph_port) -> None:  # type: ignore[no-untyped-def]
