@@ -8,6 +8,7 @@ Subcommands are registered by module path and imported only when invoked, so
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -30,7 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "node": ("aiorobot.cli._node_cmd", "nodes of the running graph: list, info"),
     "service": ("aiorobot.cli._service", "services of the running graph: list, call"),
     "action": ("aiorobot.cli._action", "actions of the running graph: list, info, send_goal"),
-    "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text or Graphviz"),
+    "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text, Graphviz or an HTML page"),
     "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
     "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
     "tf": ("aiorobot.cli._tf_cmd", "transforms of the running graph: echo (tf2_echo), tree (view_frames)"),
@@ -42,13 +43,27 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``aiorobot`` console script; returns the exit status.
 
     Ctrl-C while a command is still importing or starting ends with one line and status 130,
-    not a traceback through the import machinery.
+    not a traceback through the import machinery. A reader that goes away (``aiorobot topic
+    echo /scan | head``) ends the command quietly, as it ends ``cat``: status 141 (SIGPIPE).
     """
     try:
         return _main(argv)
     except KeyboardInterrupt:
         print("aiorobot: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        _silence_stdout()
+        return 141
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush of a closed pipe stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
 
 
 def _main(argv: Sequence[str] | None) -> int:

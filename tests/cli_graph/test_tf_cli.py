@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from collections.abc import Iterator
 
 import pytest
@@ -81,3 +84,19 @@ def test_unknown_frames_and_bad_rates_fail_with_one_line(graph: GraphProcess) ->
     assert code == 2 and err.splitlines() == [
         "aiorobot tf echo: error: --rate: expected a positive number of echoes per second, found 0.0"
     ]
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly(graph: GraphProcess) -> None:
+    # `aiorobot tf echo map laser | head -1`: the pipe closes under the command, as `cat` it ends with
+    # SIGPIPE's status and no traceback.
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "aiorobot.cli", "tf", "echo", "map", "laser", "--count", "3", "--rate", "50",
+             "--connect", f"tcp/127.0.0.1:{graph.port}"],
+            stdout=write_end, stderr=subprocess.PIPE, text=True, timeout=30,
+        )
+    finally:
+        os.close(write_end)
+    assert proc.returncode == 141 and proc.stderr == "", proc.stderr
