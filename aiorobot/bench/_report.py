@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["figure_table", "print_report", "render_report"]
+__all__ = ["figure_table", "fit_table", "headline_table", "print_report", "render_report"]
 
 
 def _f(value: Any, digits: int = 1) -> str:
@@ -175,8 +175,40 @@ def figure_table(title: str, columns: tuple[str, ...], rows: list[tuple[Any, ...
 _TABLES = {"seed": _seed_table, "timer": _timer_table, "latency": _latency_table, "cpu": _cpu_table, "tf": _tf_table}
 
 
+def headline_table(doc: dict[str, Any]) -> Any:
+    """The figure the benchmark exists for, printed first: control period p99 and max per executor model.
+
+    ``None`` when the seed part did not run (``--only`` without it).
+    """
+    from rich.table import Table
+
+    part = doc.get("parts", {}).get("seed")
+    if not part or "error" in part:
+        return None
+    cfg = part.get("config", {})
+    nominal = 1e3 * cfg.get("control_period_sec", 0.02)
+    table = Table(
+        title=f"Headline: {nominal:g} ms control period beside {1e3 * cfg.get('work_sec', 0.15):g} ms perception (ms)",
+        title_justify="left",
+        caption="perception that releases the GIL (sleep) or holds it (cpu); details in the seed table below",
+    )
+    table.add_column("model")
+    kinds = sorted({kind for kinds in part.get("models", {}).values() for kind in kinds}, key=("sleep", "cpu").index)
+    for kind in kinds:
+        table.add_column(f"{kind} p99", justify="right")
+        table.add_column(f"{kind} max", justify="right")
+    for model, results in part.get("models", {}).items():
+        cells = []
+        for kind in kinds:
+            stats = results.get(kind, {}).get("stats")
+            cells += [_f(stats["p99_ms"]), _f(stats["max_ms"])] if stats else ["failed", ""]
+        table.add_row(model, *cells)
+    table.add_row("[dim]nominal[/dim]", *[f"[dim]{nominal:g}[/dim]"] * (2 * len(kinds)))
+    return table
+
+
 def render_report(doc: dict[str, Any]) -> list[Any]:
-    """The renderables of a benchmark document: a header line, then one table per part."""
+    """The renderables of a benchmark document: the headline, a header line, then one table per part."""
     from rich.text import Text
 
     meta = doc.get("meta", {})
@@ -193,7 +225,8 @@ def render_report(doc: dict[str, Any]) -> list[Any]:
         "other programs, forkserver-started pool workers included; load = 1-minute load average.",
         style="dim",
     )
-    out: list[Any] = [header, legend]
+    headline = headline_table(doc)
+    out: list[Any] = [header, legend] if headline is None else [headline, header, legend]
     for name, part in doc.get("parts", {}).items():
         if "error" in part:
             out.append(Text(f"{name}: {part['error']}"))
@@ -218,13 +251,88 @@ def _table_for(name: str) -> Any:
 
 
 def print_report(doc: dict[str, Any], console: Any = None) -> None:
-    """Print the report to ``console`` (a rich Console; stdout by default)."""
+    """Print the report to ``console`` (a rich Console; stdout by default), stacking tables too wide for it."""
     from rich.console import Console
+    from rich.table import Table
 
     if console is None:
         console = Console()
         if not console.is_terminal:  # a file or a pipe: do not squeeze the tables into 80 columns
             console = Console(width=160)
     for item in render_report(doc):
-        console.print(item)
+        for piece in fit_table(item, console) if isinstance(item, Table) else [item]:
+            console.print(piece)
         console.print()
+
+
+#: A column of labels (model, path, ...) may wrap down to this many cells wide; figures never wrap.
+_LABEL_MIN_WIDTH = 12
+
+
+def fit_table(table: Any, console: Any) -> list[Any]:
+    """``table`` as one or more tables that fit ``console.width`` without cutting a figure short.
+
+    rich squeezes a wide table into a narrow terminal by truncating cells (``15…``), which turns
+    figures into nonsense. A table that does not fit is stacked instead: its columns are dealt
+    out, in order, to several tables that each repeat the first (label) column; the title stays
+    on the first and the caption goes under the last. Labels may wrap; figures are never cut.
+    """
+    from rich.measure import Measurement
+    from rich.table import Table
+
+    width = console.width
+    unbounded = console.options.update(width=10_000)
+    if Measurement.get(console, unbounded, table).maximum <= width or len(table.columns) < 3:
+        return [table]
+
+    def natural(column: Any) -> int:
+        cells = [column.header, *column.cells]
+        return max(Measurement.get(console, unbounded, console.render_str(c) if isinstance(c, str) else c).maximum
+                   for c in cells)
+
+    # the leading left-aligned columns name a row (model, work); the right-aligned ones are its figures
+    n_keys = 1
+    while n_keys < len(table.columns) - 1 and table.columns[n_keys].justify == "left":
+        n_keys += 1
+    keys, rest = table.columns[:n_keys], table.columns[n_keys:]
+    key_widths = [min(natural(key), max(_LABEL_MIN_WIDTH, width // (3 + n_keys))) for key in keys]
+    room = width - sum(w + 3 for w in key_widths) - 1  # a column: its cells, two of padding, one border; one closing
+    needs = [natural(column) + 3 for column in rest]
+    groups = _deal(rest, needs, room)
+    # as many tables as needed, but evenly filled: no last table holding a lone column
+    share = -(-sum(needs) // len(groups))
+    for target in range(share, room + 1):
+        even = _deal(rest, needs, target)
+        if len(even) == len(groups):
+            groups = even
+            break
+    pieces = []
+    for i, group in enumerate(groups):
+        piece = Table(
+            title=table.title if i == 0 else None,
+            title_justify=table.title_justify,
+            caption=table.caption if i == len(groups) - 1 else None,
+        )
+        for key, key_width in zip(keys, key_widths):
+            piece.add_column(key.header, justify=key.justify, style=key.style, header_style=key.header_style,
+                             max_width=key_width, overflow="fold")
+        for column in group:
+            piece.add_column(column.header, justify=column.justify, style=column.style,
+                             header_style=column.header_style, no_wrap=True)
+        for row in zip(*(list(c.cells) for c in (*keys, *group))):
+            piece.add_row(*row)
+        pieces.append(piece)
+    return pieces
+
+
+def _deal(columns: list[Any], needs: list[int], room: int) -> list[list[Any]]:
+    """Columns in order into groups of at most ``room`` cells each (a wider column gets a group of its own)."""
+    groups: list[list[Any]] = [[]]
+    used = 0
+    for column, need in zip(columns, needs):
+        if groups[-1] and used + need > room:
+            groups.append([])
+            used = 0
+        groups[-1].append(column)
+        used += need
+    return groups

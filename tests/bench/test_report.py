@@ -72,3 +72,45 @@ def test_a_part_outside_the_builtin_ones_is_drawn_by_its_own_module(monkeypatch:
     print_report({"meta": {}, "parts": {"extra": {"scan ms": 0.25}}}, console)
     text = console.export_text()
     assert "extra part" in text and "scan ms" in text and "0.25" in text
+
+
+def _wide_doc() -> dict[str, Any]:
+    doc = _doc()
+    stats = period_stats([20.0, 20.5, 27.0], 20.0).as_dict()
+    doc["parts"]["seed"]["models"]["threads"] = {"sleep": {"stats": stats, "noise": NOISE}, "cpu": {"stats": stats, "noise": NOISE}}
+    return doc
+
+
+def test_an_80_column_terminal_gets_stacked_tables_with_every_figure_whole() -> None:
+    console = Console(record=True, width=80)
+    print_report(_wide_doc(), console)
+    text = console.export_text()
+    assert "…" not in text
+    assert max(len(line) for line in text.splitlines()) <= 80
+    # every figure of the seed table is there, whole: max 27.0, steal 12.5, load 1.50, rclpy's published 172.1
+    for figure in ("27.0", "12.5", "1.50", "172.1", "RuntimeError: no priority loop"):
+        assert figure in text.replace("\n", " ") or figure in text, figure
+    # the stacked tables repeat the row labels (model and work) so each row stays readable
+    seed_tables = text.split("Seed experiment")[1].split("CPU cost")[0]
+    assert seed_tables.count("┃ model") >= 2 and seed_tables.count("┃ work") >= 2
+
+
+def test_a_wide_terminal_keeps_one_table_per_part() -> None:
+    text = _render(_wide_doc())
+    assert text.split("Seed experiment")[1].split("CPU cost")[0].count("┃ model") == 1
+
+
+def test_the_headline_comes_first_control_p99_and_max_per_model() -> None:
+    text = _render(_wide_doc())
+    first = text.lstrip().splitlines()[0]
+    assert first.startswith("Headline: 20 ms control period")
+    headline = text.split("aiorobot bench latency")[0]
+    row = next(line for line in headline.splitlines() if "threads" in line)
+    assert [c.strip() for c in row.split("│")[2:6]] == ["26.9", "27.0", "26.9", "27.0"]
+    assert "failed" in next(line for line in headline.splitlines() if "aiorobot" in line)
+
+
+def test_no_headline_without_the_seed_part() -> None:
+    doc = _doc()
+    del doc["parts"]["seed"]
+    assert "Headline" not in _render(doc)
