@@ -79,15 +79,19 @@ def main(args: argparse.Namespace) -> int:
     from ._report import print_report
     from ._runner import python_argv, run_benchmark
 
+    from ._progress import BenchProgress
+
     err = Console(stderr=True)
-    doc = run_benchmark(
-        parts,
-        quick=args.quick,
-        repeat=args.repeat,
-        periods=args.periods,
-        command=python_argv(),
-        progress=lambda what: err.print(f"[dim]running {what} ...[/dim]"),
-    )
+    with BenchProgress(err, len(parts), args.repeat) as progress:
+        doc = run_benchmark(
+            parts,
+            quick=args.quick,
+            repeat=args.repeat,
+            periods=args.periods,
+            command=python_argv(),
+            progress=progress,
+            fraction=progress.fraction,
+        )
     print_report(doc)
     if args.json is not None:
         try:

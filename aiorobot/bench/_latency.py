@@ -6,7 +6,7 @@ Paths measured, each with a Twist (52 bytes of CDR) and a 640x480x3 uint8 Image:
 - ``main -> priority``: the subscriber node on the priority loop;
 - ``process pool``: ``await node.offload(echo, msg)``, the round trip through
   the runtime's process pool (the message goes there and back);
-- ``zenoh``: not measured yet (the transport lands in its own issue).
+- ``zenoh``: a pointer row; two-process figures are the ``zenoh`` part's (:mod:`aiorobot.bench._zenoh`).
 
 Latency: one message at a time, from just before ``publish`` to the start of the
 subscriber's callback (one clock, ``time.perf_counter``, read in both threads).
@@ -26,7 +26,7 @@ from ._stats import latency_stats
 
 __all__ = ["ZENOH_NOTE", "echo", "run"]
 
-ZENOH_NOTE = "not available (transport lands in its own issue)"
+ZENOH_NOTE = "two processes: see the zenoh transport table"
 _BURST = 500
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime
 import importlib
 import importlib.util
+import inspect
 import os
 import platform
 import sys
@@ -32,14 +33,19 @@ PARTS: dict[str, str] = {
 }
 
 
-def _run_part(name: str, quick: bool, periods: int | None) -> dict[str, Any]:
+def _run_part(
+    name: str, quick: bool, periods: int | None, fraction: Callable[[float], None] | None = None
+) -> dict[str, Any]:
     module_name = PARTS[name]
     if importlib.util.find_spec(module_name) is None:
         return {"error": f"not available: {module_name} is not installed"}
     module = importlib.import_module(module_name)
+    kwargs: dict[str, Any] = {"quick": quick}
     if name == "seed":
-        return module.run(quick=quick, periods=periods)
-    return module.run(quick=quick)
+        kwargs["periods"] = periods
+    if fraction is not None and "progress" in inspect.signature(module.run).parameters:
+        kwargs["progress"] = fraction  # a part that can tell how far it is: run(..., progress=callback(0..1))
+    return module.run(**kwargs)
 
 
 def machine_info() -> dict[str, Any]:
@@ -61,12 +67,15 @@ def run_benchmark(
     periods: int | None = None,
     command: str = "aiorobot bench latency",
     progress: Callable[[str], None] | None = None,
+    fraction: Callable[[float], None] | None = None,
 ) -> dict[str, Any]:
     """Run ``parts`` ``repeat`` times each; every figure is the median of the repeats.
 
     Returns the JSON document: ``meta`` (machine, date, options), ``parts`` (the
     median figures of each part, raw samples of every repeat concatenated) and,
-    when ``repeat > 1``, ``repeats`` (each repeat's own figures).
+    when ``repeat > 1``, ``repeats`` (each repeat's own figures). ``progress`` is called with
+    each part's name as it starts; ``fraction`` with how far (0..1) the running part is, for
+    parts whose ``run`` takes a ``progress`` callback.
     """
     unknown = [p for p in parts if p not in PARTS]
     if unknown:
@@ -92,7 +101,7 @@ def run_benchmark(
                     progress(f"{name}" + (f" (repeat {k + 1}/{repeat})" if repeat > 1 else ""))
                 with NoiseMeter() as part_meter:
                     try:
-                        result = _run_part(name, quick, periods)
+                        result = _run_part(name, quick, periods, fraction)
                     except Exception as err:  # one failing part must not hide the others
                         result = {"error": f"{type(err).__name__}: {err}"}
                 assert part_meter.result is not None

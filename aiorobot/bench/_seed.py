@@ -80,7 +80,12 @@ def run_model(model: str, kind: str, cfg: SeedConfig) -> dict[str, Any]:
     }
 
 
-def run(quick: bool = False, periods: int | None = None, models: tuple[str, ...] = MODELS) -> dict[str, Any]:
+def run(
+    quick: bool = False,
+    periods: int | None = None,
+    models: tuple[str, ...] = MODELS,
+    progress: Callable[[float], None] | None = None,
+) -> dict[str, Any]:
     """Run every model under both perception kinds.
 
     Parameters
@@ -89,12 +94,16 @@ def run(quick: bool = False, periods: int | None = None, models: tuple[str, ...]
         A smoke run: 5 periods after 2 warm-up (unless ``periods`` is given).
     periods
         Control periods measured per model and kind (default 200).
+    progress
+        Called with the fraction (0..1) of model runs done, after each.
     """
     if quick:
         cfg = SeedConfig(periods=periods or 5, warmup=2)
     else:
         cfg = SeedConfig(periods=periods or 200)
     results: dict[str, dict[str, Any]] = {}
+    if progress is not None:
+        progress(0.0)
     with NoiseMeter() as meter:
         for model in models:
             results[model] = {}
@@ -103,6 +112,8 @@ def run(quick: bool = False, periods: int | None = None, models: tuple[str, ...]
                     results[model][kind] = run_model(model, kind, cfg)
                 except Exception as err:  # a model that cannot run is reported, the others still run
                     results[model][kind] = {"error": f"{type(err).__name__}: {err}"}
+                if progress is not None:
+                    progress(sum(map(len, results.values())) / (len(models) * len(KINDS)))
     assert meter.result is not None
     return {
         "config": cfg.as_dict(),

@@ -38,7 +38,7 @@ def test_quick_run_succeeds_and_prints_every_table(quick_run) -> None:
         assert title in proc.stdout
     assert "rclpy SingleThreadedExecutor" in proc.stdout
     assert "rclpy MultiThreadedExecutor + groups" in proc.stdout
-    assert "not available (transport lands in its own issue)" in proc.stdout
+    assert "zenoh: two processes: see the zenoh transport table" in proc.stdout
 
 
 def test_json_holds_every_part_model_and_kind(quick_run) -> None:
