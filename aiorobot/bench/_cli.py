@@ -79,8 +79,11 @@ def main(args: argparse.Namespace) -> int:
     from ._report import print_report
     from ._runner import python_argv, run_benchmark
 
+    from aiorobot._logging import setup_logging
+
     from ._progress import BenchProgress
 
+    setup_logging("warning")  # the parts' nodes say INFO things ("recording /cmd_vel ...") that would tear the bars
     err = Console(stderr=True)
     with BenchProgress(err, len(parts), args.repeat) as progress:
         doc = run_benchmark(

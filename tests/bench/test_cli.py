@@ -90,6 +90,13 @@ def test_only_and_repeat_run_the_chosen_part_and_keep_each_repeat(tmp_path: Path
     assert doc["meta"]["repeat"] == 2
 
 
+def test_the_parts_own_nodes_keep_info_chatter_out_of_the_progress_display(tmp_path: Path) -> None:
+    # the bag part's recorder and Foxglove bridge log INFO lines; they would tear the progress bars
+    proc = _aiorobot("bench", "latency", "--quick", "--only", "bag", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "[INFO]" not in proc.stderr and "recorded" in proc.stdout
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
