@@ -226,6 +226,9 @@ class Simulator(Node):
 
         self._static_tf = tf.StaticTransformBroadcaster(self)
         self._tf = tf.TransformBroadcaster(self) if self.publish_odom_tf else None
+        # at construction, before any loop runs: a first run after installing compiles the kernels
+        # (seconds), which on a running loop is a stall the loop monitor rightly reports
+        self._warm_up()
 
     def __repr__(self) -> str:
         return f"<Simulator {self.world.name} {self.robot_kind} t={self.time_ns / _NS:.3f}s rtf={self.real_time_factor:g}>"
@@ -280,7 +283,6 @@ class Simulator(Node):
         stamp = self._stamp()
         self._publish_static(stamp)
         self.map_pub.publish(occupancy_grid_message(self.world, stamp, FRAMES["map"]))
-        self._warm_up()
         lockstep = self.real_time_factor == 0.0
         if lockstep:
             await settle(runtime)
