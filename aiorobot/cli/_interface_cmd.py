@@ -107,6 +107,7 @@ def show_text(name: str) -> str:
 
 
 def _append(lines: list[str], spec: Any, package: str, depth: int) -> None:
+    from ..msgs._describe import _type_text
     from ..msgs._registry import get_spec
 
     indent = "\t" * depth
@@ -120,23 +121,6 @@ def _append(lines: list[str], spec: Any, package: str, depth: int) -> None:
         if f.type.is_message:
             nested = get_spec(f.type.base)
             _append(lines, nested, f.type.base.split("/", 1)[0], depth + 1)
-
-
-def _type_text(t: Any, package: str) -> str:
-    """A field type as written in a .msg file: ``Vector3`` within its package, else ``pkg/Type``."""
-    from ..msgs._spec import ARRAY, SCALAR
-
-    base = t.base
-    if t.is_message:
-        pkg, _, short = base.split("/")
-        base = short if pkg == package else f"{pkg}/{short}"
-    if t.string_bound:
-        base = f"{base}<={t.string_bound}"
-    if t.kind == ARRAY:
-        return f"{base}[{t.count}]"
-    if t.kind != SCALAR:
-        return f"{base}[<={t.count}]" if t.count else f"{base}[]"
-    return base
 
 
 def _literal(value: Any) -> str:

@@ -106,8 +106,12 @@ def _short(name: str) -> str:
     return f"{pkg}/{short}" if kind == "msg" else name
 
 
-def _type_text(t: FieldType) -> str:
-    base = _short(t.base) if t.is_message else t.base
+def _type_text(t: FieldType, package: str | None = None) -> str:
+    """A field type as a .msg file writes it: ``pkg/Type`` (just ``Type`` inside ``package``), bounds, arrays."""
+    base = t.base
+    if t.is_message:
+        pkg, _, short = base.split("/")
+        base = short if pkg == package else _short(base)
     if t.string_bound:
         base = f"{base}<={t.string_bound}"
     if t.kind == ARRAY:
