@@ -137,6 +137,7 @@ class Publisher(Endpoint, Generic[M]):
         self._alive = True
         self._lifespan_ns = finite_ns(qos.lifespan)
         self._info = False  # deliver (message, MessageInfo data) pairs instead of messages
+        self._watched = False  # publish is _publish_watched
         self._choose_path(False)
 
     def __repr__(self) -> str:
@@ -153,10 +154,12 @@ class Publisher(Endpoint, Generic[M]):
         """Publish through :meth:`_publish_watched` when a QoS watcher, a lifespan or a subscriber
         that takes MessageInfo needs it; otherwise through the plain :meth:`publish`."""
         self._info = self._lifespan_ns is not None or subscriber_wants_info
-        if self._info or self._deadline is not None or self._liveliness is not None:
+        watched = self._info or self._deadline is not None or self._liveliness is not None
+        if watched and not self._watched:
             self.publish = self._publish_watched  # type: ignore[method-assign]
-        else:
-            self.__dict__.pop("publish", None)
+        elif self._watched and not watched:
+            del self.publish  # (never through __dict__: that would slow every attribute of this object)
+        self._watched = watched
 
     def _set_targets(self, subs: tuple[Subscription | Tap, ...]) -> None:
         """Install the matched subscriptions (called by the bus under its lock)."""
