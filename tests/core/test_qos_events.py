@@ -346,3 +346,14 @@ async def test_lifespan_drops_expired_messages_from_a_queue(sim_runtime, sim_clo
     assert msg.data == 2
     assert stream.subscription.queued == 0
     stream.close()
+
+
+async def test_deadline_on_wall_time_fires(runtime):
+    # the same watcher without sim time: a 20 ms deadline after one message fires (bounded wait)
+    node = runtime.add_node(Node("wall"))
+    missed = asyncio.Event()
+    qos = QoSProfile(deadline=Duration(seconds=0.02))
+    node.create_subscription(Int32, TOPIC, lambda m: None, qos,
+                             event_callbacks=SubscriptionEventCallbacks(deadline=lambda info: missed.set()))
+    node.create_publisher(Int32, TOPIC, qos).publish(Int32(data=1))
+    await asyncio.wait_for(missed.wait(), 10.0)
