@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from ._errors import QoSIncompatibleError
 from ._mutation import PublishGuard
 from ._pubsub import Endpoint, Publisher, Subscription, Tap
-from ._qos import DurabilityPolicy, incompatibility
+from ._qos import DurabilityPolicy, QoSPolicyKind, incompatibility, incompatible_policy
 from ._services import ServiceRegistry
 
 if TYPE_CHECKING:
@@ -128,6 +128,7 @@ class Bus:
             for p, s, reason in bad:
                 topic.incompatible.append((p, s, reason))
                 self._report(topic, p, s, reason)
+                self._raise_events(p, s)
             for pub in retarget:
                 self._retarget(topic, pub)
             for p, s in pairs:
@@ -138,6 +139,20 @@ class Bus:
                 ):
                     self._replay(p, s)
         self._notify_added(endpoint)
+
+    @staticmethod
+    def _raise_events(pub: Publisher, sub: Sub) -> None:
+        """Count a pair that does not connect on both endpoints' incompatible QoS (with the
+        policy) or incompatible type event handlers, as rmw does."""
+        if pub.type_name != sub.type_name:
+            name, policy = "incompatible_type", None
+        else:
+            found = incompatible_policy(pub.qos, sub.qos)
+            name, policy = "incompatible_qos", found[0] if found is not None else QoSPolicyKind.INVALID
+        for endpoint in (pub, sub):
+            handler = getattr(endpoint, "_events", {}).get(name)
+            if handler is not None:
+                handler._fire(1, policy=policy)
 
     def remove(self, endpoint: Endpoint) -> None:
         with self._lock:
@@ -185,13 +200,19 @@ class Bus:
 
     @staticmethod
     def _replay(pub: Publisher, sub: Sub) -> None:
-        """Hand a late-joining transient-local subscription the publisher's history, in order."""
+        """Hand a late-joining transient-local subscription the publisher's history, in order,
+        leaving out messages whose lifespan has run out."""
         assert pub._history is not None
-        for msg in list(pub._history):
+        now = pub.node._clock.now_ns() if pub._lifespan_ns is not None else 0
+        for msg, meta in list(pub._history):
+            if meta is not None and meta[2] is not None and now >= meta[2]:
+                continue
             if isinstance(sub, Tap):
                 sub._enqueue(msg)
-            else:
+            elif meta is None:
                 sub.node._call_soon(sub._enqueue, msg)
+            else:
+                sub.node._call_soon(sub._deliver, msg, meta)
 
     def preview(
         self, publishers: Sequence[Publisher], subscriptions: Sequence[Sub]

@@ -25,6 +25,7 @@ from ._names import join_fqn, resolve_name, validate_namespace, validate_node_na
 from ._node_graph import NodeGraphMixin
 from ._node_parameters import NodeParametersMixin
 from .parameters._store import ParameterStore
+from ._event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile
 from ._services import Client, Service
@@ -165,9 +166,22 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
     # -- entities ---------------------------------------------------------------------
 
-    def create_publisher(self, msg_type: type[M], topic: str, qos: QoSProfile | int) -> Publisher[M]:
-        pub: Publisher[M] = Publisher(self, msg_type, self.resolve_topic_name(topic), to_qos_profile(qos))
+    def create_publisher(
+        self,
+        msg_type: type[M],
+        topic: str,
+        qos: QoSProfile | int,
+        *,
+        callback_group: CallbackGroup | None = None,
+        event_callbacks: PublisherEventCallbacks | None = None,
+    ) -> Publisher[M]:
+        """A :class:`Publisher` of ``msg_type`` on ``topic``; ``event_callbacks`` get its QoS events
+        (deadline missed, liveliness lost, incompatible QoS or type), run in ``callback_group``."""
         _check_msg_type(msg_type)
+        pub: Publisher[M] = Publisher(
+            self, msg_type, self.resolve_topic_name(topic), to_qos_profile(qos),
+            event_callbacks=event_callbacks, callback_group=callback_group or self._default_group,
+        )
         self._publishers.append(pub)
         if self._runtime is not None:
             try:
@@ -175,6 +189,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             except BaseException:
                 self._publishers.remove(pub)
                 raise
+            if self._started:
+                self._call_soon(pub._start)
         return pub
 
     def create_subscription(
@@ -185,10 +201,15 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         qos: QoSProfile | int,
         *,
         callback_group: CallbackGroup | None = None,
+        event_callbacks: SubscriptionEventCallbacks | None = None,
+        raw: bool = False,
     ) -> Subscription[M]:
+        """Call ``callback(msg)`` for each message on ``topic``; a callback that cannot take one
+        argument but can take two gets ``(msg, message_info)`` (rclpy's MessageInfo dict).
+        ``raw=True`` hands it the message's CDR bytes; ``event_callbacks`` get the QoS events."""
         if not callable(callback):
             raise TypeError(f"subscription callback must be callable, got {callback!r}")
-        return self._add_subscription(msg_type, topic, callback, qos, callback_group)
+        return self._add_subscription(msg_type, topic, callback, qos, callback_group, event_callbacks, raw)
 
     def subscribe(self, msg_type: type[M], topic: str, qos: QoSProfile | int = 10) -> MessageStream[M]:
         """Receive a topic as an async iterator: ``async for msg in node.subscribe(T, "/x")``."""
@@ -201,6 +222,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         callback: Callable[[M], Any] | None,
         qos: QoSProfile | int,
         group: CallbackGroup | None,
+        event_callbacks: SubscriptionEventCallbacks | None = None,
+        raw: bool = False,
     ) -> Subscription[M]:
         _check_msg_type(msg_type)
         sub: Subscription[M] = Subscription(
@@ -210,6 +233,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             callback,
             to_qos_profile(qos),
             group or self._default_group,
+            event_callbacks=event_callbacks,
+            raw=raw,
         )
         self._subscriptions.append(sub)
         if self._runtime is not None:
@@ -257,6 +282,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             pub.destroyed = True
             if self._runtime is not None:
                 self._runtime._bus.remove(pub)
+            self._call_soon(pub._stop)
 
     def destroy_subscription(self, sub: Subscription[Any]) -> None:
         if sub in self._subscriptions:
@@ -268,6 +294,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     @staticmethod
     def _close_subscription(sub: Subscription[Any]) -> None:
         sub.destroyed = True
+        if sub._deadline is not None:
+            sub._deadline.stop()
         if sub._task is not None:
             sub._task.cancel()
         waiter = sub._waiter
@@ -485,6 +513,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         if self._started:
             return
         self._started = True
+        for pub in self._publishers:
+            pub._start()
         for sub in self._subscriptions:
             sub._start()
         for timer in self._timers:

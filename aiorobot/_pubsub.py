@@ -27,19 +27,31 @@ from __future__ import annotations
 import asyncio
 import inspect
 import threading
+import time
 from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from ._mutation import PublishGuard, digest
 from .msgs._classgen import freezer
-from ._qos import DurabilityPolicy, QoSProfile
+from ._event_handler import Lease, PublisherEventCallbacks, SubscriptionEventCallbacks
+from ._qos import DurabilityPolicy, LivelinessPolicy, QoSProfile, finite_ns
 
 if TYPE_CHECKING:
     from ._groups import CallbackGroup
     from ._node import Node
 
-__all__ = ["Endpoint", "MessageStream", "Publisher", "Subscription", "Tap"]
+__all__ = ["Endpoint", "MessageInfo", "MessageStream", "Publisher", "Subscription", "Tap"]
+
+#: What a subscription callback taking two arguments gets besides the message, as rclpy's
+#: ``rclpy.subscription.MessageInfo``: a dict with ``source_timestamp`` and
+#: ``received_timestamp`` (system time, ns), ``publication_sequence_number`` (the
+#: publisher's count, from 1; None when unknown) and ``reception_sequence_number``
+#: (this subscription's count, from 1).
+MessageInfo = dict
+
+#: A dispatcher's marker for a message whose lifespan ran out while it was queued.
+_EXPIRED = object()
 
 M = TypeVar("M")
 
@@ -81,9 +93,20 @@ class Publisher(Endpoint, Generic[M]):
     kind = "publisher"
     node: Node
 
-    def __init__(self, node: Node, msg_type: type[M], topic: str, qos: QoSProfile) -> None:
+    def __init__(
+        self,
+        node: Node,
+        msg_type: type[M],
+        topic: str,
+        qos: QoSProfile,
+        *,
+        event_callbacks: PublisherEventCallbacks | None = None,
+        callback_group: CallbackGroup | None = None,
+    ) -> None:
         super().__init__(node, msg_type, topic, qos)
-        self._history: deque[Any] | None = (
+        self.callback_group = callback_group
+        # (message, (source ns, sequence number, expiry ns on the node clock) or None)
+        self._history: deque[tuple[Any, Any]] | None = (
             deque(maxlen=qos.depth) if qos.durability is DurabilityPolicy.TRANSIENT_LOCAL else None
         )
         self._subs: tuple[Subscription | Tap, ...] = ()
@@ -96,6 +119,26 @@ class Publisher(Endpoint, Generic[M]):
         self._freeze = getattr(msg_type, "_cp", None)  # generated message classes only
         self._frozen_classes = freezer(topic)
         self.published = 0
+        if event_callbacks is not None and not isinstance(event_callbacks, PublisherEventCallbacks):
+            raise TypeError(f"event_callbacks: expected a PublisherEventCallbacks, found {event_callbacks!r}")
+        self._events = (
+            event_callbacks.create_event_handlers(callback_group, self) if event_callbacks is not None else {}
+        )
+        #: The QoS event handlers of this publisher (rclpy's attribute).
+        self.event_handlers = list(self._events.values())
+        # QoS watchers; None (no cost) for the default, infinite deadline and lease
+        deadline = finite_ns(qos.deadline)
+        lease = finite_ns(qos.liveliness_lease_duration)
+        self._deadline = Lease(node, deadline, self._deadline_missed, repeat=True) if deadline else None
+        self._liveliness = (
+            Lease(node, lease, self._liveliness_lost, repeat=False)
+            if lease and qos.liveliness is LivelinessPolicy.MANUAL_BY_TOPIC else None
+        )
+        self._alive = True
+        self._lifespan_ns = finite_ns(qos.lifespan)
+        self._info = False  # deliver (message, MessageInfo data) pairs instead of messages
+        self._watched = False  # publish is _publish_watched
+        self._choose_path(False)
 
     def __repr__(self) -> str:
         return (
@@ -107,8 +150,28 @@ class Publisher(Endpoint, Generic[M]):
         """How many subscriptions (in this process and, with a transport, remote) receive this publisher."""
         return sum(1 for s in self._subs if not getattr(s, "hidden", False))
 
+    def _choose_path(self, subscriber_wants_info: bool) -> None:
+        """Publish through :meth:`_publish_watched` when a QoS watcher, a lifespan or a subscriber
+        that takes MessageInfo needs it; otherwise through the plain :meth:`publish`."""
+        self._info = self._lifespan_ns is not None or subscriber_wants_info
+        watched = self._info or self._deadline is not None or self._liveliness is not None
+        if watched and not self._watched:
+            self.publish = self._publish_watched  # type: ignore[method-assign]
+        elif self._watched and not watched:
+            del self.publish  # (never through __dict__: that would slow every attribute of this object)
+        self._watched = watched
+
     def _set_targets(self, subs: tuple[Subscription | Tap, ...]) -> None:
         """Install the matched subscriptions (called by the bus under its lock)."""
+        before = {id(s): s for s in self._subs if isinstance(s, Subscription)}
+        after = {id(s): s for s in subs if isinstance(s, Subscription)}
+        for key, sub in before.items():
+            if key not in after:  # unmatched: it no longer counts this publisher
+                sub._liveliness_changed(-1, 0) if self._alive else sub._liveliness_changed(0, -1)
+        for key, sub in after.items():
+            if key not in before:
+                sub._liveliness_changed(1, 0) if self._alive else sub._liveliness_changed(0, 1)
+        self._choose_path(any(sub._wants_info for sub in after.values()))
         own_loop = self.node._loop
         self._thread_id = self.node._thread_id
         self._own_loop = own_loop
@@ -154,7 +217,7 @@ class Publisher(Endpoint, Generic[M]):
                 throttle_duration_sec=1.0,
             )
         if self._history is not None:
-            self._history.append(msg)
+            self._history.append((msg, None))
         if threading.get_ident() == self._thread_id:
             for sub in self._same_loop:
                 sub._enqueue(msg)
@@ -168,8 +231,100 @@ class Publisher(Endpoint, Generic[M]):
         for tap in self._taps:
             tap._enqueue(msg)
 
+    def _publish_watched(self, msg: M) -> None:
+        """:meth:`publish` for a publisher with a finite deadline, lease or lifespan, or with a
+        subscriber that takes MessageInfo: restarts its leases, and hands subscribers the
+        message's source time, sequence number and expiry with it."""
+        if not isinstance(msg, self.msg_type):
+            raise TypeError(
+                f"publisher on {self.topic_name} expects {self.type_name}, got {type(msg).__name__}: {msg!r}"
+            )
+        if self.destroyed:
+            raise RuntimeError(f"{self!r} was destroyed")
+        self.published += 1
+        if self._deadline is not None:
+            self._deadline.touch()
+        if self._liveliness is not None:
+            self._assert_alive()
+        meta = None
+        if self._info:
+            lifespan = self._lifespan_ns
+            expiry = self.node._clock.now_ns() + lifespan if lifespan is not None else None
+            meta = (time.time_ns(), self.published, expiry)
+        if self._freeze is not None and (self._subs or self._history is not None):
+            msg = self._freeze(msg, self._frozen_classes)
+        if self._guard is not None and not self._guard.check(msg):
+            self.node.get_logger().error(
+                f"debug_messages: a message published on {self.topic_name} was changed after publish "
+                "(through an array it shares with subscribers); publish a new array each time",
+                throttle_duration_sec=1.0,
+            )
+        if self._history is not None:
+            self._history.append((msg, meta))
+        if meta is None:
+            deliver: Callable[..., None] = _enqueue_all
+            args: tuple[Any, ...] = (msg,)
+        else:
+            deliver, args = _deliver_all, (msg, meta)
+        if threading.get_ident() == self._thread_id:
+            deliver(self._same_loop, *args)
+        elif self._same_loop and self._own_loop is not None:
+            _call_threadsafe(self._own_loop, deliver, self._same_loop, *args)
+        for loop, subs in self._other_loops:
+            _call_threadsafe(loop, deliver, subs, *args)
+        for tap in self._taps:
+            tap._enqueue(msg)
+
+    def assert_liveliness(self) -> None:
+        """Assert that this publisher is alive without publishing (rclpy's), for
+        ``LivelinessPolicy.MANUAL_BY_TOPIC``; a no-op for an ``AUTOMATIC`` publisher."""
+        if self._liveliness is not None:
+            self._assert_alive()
+
+    def _assert_alive(self) -> None:
+        assert self._liveliness is not None
+        self._liveliness.touch()
+        if not self._alive:
+            self._alive = True
+            for sub in self._subs:
+                if isinstance(sub, Subscription):
+                    sub._liveliness_changed(1, -1)
+
+    def _liveliness_lost(self) -> None:
+        self._alive = False
+        handler = self._events.get("liveliness")
+        if handler is not None:
+            handler._fire(1)
+        for sub in self._subs:
+            if isinstance(sub, Subscription):
+                sub._liveliness_changed(-1, 1)
+
+    def _deadline_missed(self) -> None:
+        handler = self._events.get("deadline")
+        if handler is not None:
+            handler._fire(1)
+
+    def _start(self) -> None:
+        """Start the QoS watchers (on the node's loop); a manual-liveliness publisher's first
+        lease starts now."""
+        if self._deadline is not None:
+            self._deadline.start()
+        if self._liveliness is not None:
+            self._liveliness.touch()
+            self._liveliness.start()
+
+    def _stop(self) -> None:
+        for lease in (self._deadline, self._liveliness):
+            if lease is not None:
+                lease.stop()
+
     def destroy(self) -> None:
         self.node.destroy_publisher(self)
+
+
+def _deliver_all(subs: tuple[Subscription, ...], msg: Any, meta: Any) -> None:
+    for sub in subs:
+        sub._deliver(msg, meta)
 
 
 def _enqueue_all(subs: tuple[Subscription, ...], msg: Any) -> None:
@@ -221,10 +376,16 @@ class Subscription(Endpoint, Generic[M]):
         callback: Callable[[M], Any] | None,
         qos: QoSProfile,
         group: CallbackGroup,
+        *,
+        event_callbacks: SubscriptionEventCallbacks | None = None,
+        raw: bool = False,
     ) -> None:
         super().__init__(node, msg_type, topic, qos)
         self.callback = callback
         self.callback_group = group
+        self.raw = raw
+        #: The callback takes ``(msg, message_info)``, as rclpy decides (it cannot take one argument).
+        self._wants_info = callback is not None and _takes_message_info(callback)
         self._queue: deque[Any] = deque()
         self._limit = qos.queue_limit
         self._waiter: asyncio.Future[None] | None = None
@@ -233,6 +394,19 @@ class Subscription(Endpoint, Generic[M]):
         self._debug = False  # Runtime(debug_messages=True): check callbacks leave messages as they found them
         self.received = 0
         self.dropped = 0
+        if event_callbacks is not None and not isinstance(event_callbacks, SubscriptionEventCallbacks):
+            raise TypeError(f"event_callbacks: expected a SubscriptionEventCallbacks, found {event_callbacks!r}")
+        self._events = event_callbacks.create_event_handlers(group, self) if event_callbacks is not None else {}
+        #: The QoS event handlers of this subscription (rclpy's attribute).
+        self.event_handlers = list(self._events.values())
+        self._lost = self._events.get("message_lost")
+        deadline = finite_ns(qos.deadline)
+        self._deadline = Lease(node, deadline, self._deadline_missed, repeat=True) if deadline else None
+        # In "info" mode a deque parallel to the queue holds each message's (publisher data or
+        # None, received ns, reception number); plain subscriptions have none (no cost).
+        self._infos: deque[tuple[Any, int, int]] | None = None
+        if self._wants_info or self._deadline is not None or self._lost is not None:
+            self._use_infos()
 
     def __repr__(self) -> str:
         return (
@@ -263,6 +437,68 @@ class Subscription(Endpoint, Generic[M]):
             if not waiter.done():
                 waiter.set_result(None)
 
+    def _use_infos(self) -> None:
+        """Switch to info mode (on the node's loop thread): existing messages get no publisher data."""
+        if self._infos is None:
+            now = time.time_ns()
+            self._infos = deque((None, now, 0) for _ in self._queue)
+            self._enqueue = self._enqueue_without_info  # type: ignore[method-assign]
+
+    def _enqueue_without_info(self, msg: Any) -> None:
+        self._deliver(msg, None)
+
+    def _deliver(self, msg: Any, meta: Any) -> None:
+        """Put ``msg`` with its publisher data ``meta`` into the queue (on the node's loop thread)."""
+        if self.destroyed:
+            return
+        if self._infos is None:
+            self._use_infos()
+        queue, infos = self._queue, self._infos
+        assert infos is not None
+        if self._limit is not None and len(queue) >= self._limit:
+            queue.popleft()
+            infos.popleft()
+            self.dropped += 1
+            if self._lost is not None:
+                self._lost._fire(1)
+        queue.append(msg)
+        self.received += 1
+        infos.append((meta, time.time_ns(), self.received))
+        if self._deadline is not None:
+            self._deadline.touch()
+        waiter = self._waiter
+        if waiter is not None:
+            self._waiter = None
+            if not waiter.done():
+                waiter.set_result(None)
+
+    def _take_info(self, msg: Any) -> Any:
+        """The next queued message's info: ``_EXPIRED`` when its lifespan ran out, ``(msg,
+        MessageInfo)`` for a callback that takes it, else ``msg``."""
+        assert self._infos is not None
+        meta, received_ns, number = self._infos.popleft()
+        if meta is not None and meta[2] is not None and self.node._clock.now_ns() >= meta[2]:
+            return _EXPIRED
+        if not self._wants_info:
+            return msg
+        info: MessageInfo = {
+            "source_timestamp": meta[0] if meta is not None else received_ns,
+            "received_timestamp": received_ns,
+            "publication_sequence_number": meta[1] if meta is not None else None,
+            "reception_sequence_number": number,
+        }
+        return (msg, info)
+
+    def _liveliness_changed(self, alive: int, not_alive: int) -> None:
+        handler = self._events.get("liveliness")
+        if handler is not None:
+            handler._fire(alive, not_alive)
+
+    def _deadline_missed(self) -> None:
+        handler = self._events.get("deadline")
+        if handler is not None:
+            handler._fire(1)
+
     async def _wait(self) -> None:
         waiter = asyncio.get_running_loop().create_future()  # always the node's loop
         self._waiter = waiter
@@ -273,7 +509,9 @@ class Subscription(Endpoint, Generic[M]):
                 self._waiter = None
 
     def _start(self) -> None:
-        """Start the dispatcher (on the node's loop)."""
+        """Start the dispatcher and the deadline watcher (on the node's loop)."""
+        if self._deadline is not None:
+            self._deadline.start()
         if self.callback is not None and self._task is None:
             self._task = self.node._create_task(
                 self._dispatch(), name=f"dispatch {self.topic_name} -> {self.node_name}"
@@ -287,6 +525,10 @@ class Subscription(Endpoint, Generic[M]):
         assert callback is not None
         if self._debug:
             callback = self._checked(callback)
+        if self.raw:
+            callback = _raw(callback)
+        if self._wants_info:
+            callback = _with_info(callback)
         handled = 0
         while True:
             if not queue:
@@ -294,6 +536,10 @@ class Subscription(Endpoint, Generic[M]):
                 await self._wait()
                 continue
             msg = queue.popleft()
+            if self._infos is not None:
+                msg = self._take_info(msg)
+                if msg is _EXPIRED:
+                    continue
             if group.exclusive:
                 self._busy += 1
                 try:
@@ -312,12 +558,12 @@ class Subscription(Endpoint, Generic[M]):
     def _callback_done(self, _task: asyncio.Task[None]) -> None:
         self._busy -= 1
 
-    def _checked(self, callback: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    def _checked(self, callback: Callable[..., Any]) -> Callable[..., Any]:
         """``callback``, reporting when it changes the (shared) message it was given."""
 
-        async def checked(msg: Any) -> Any:
+        async def checked(msg: Any, *info: Any) -> Any:
             before = digest(msg)
-            result = callback(msg)
+            result = callback(msg, *info)
             if result is not None and inspect.isawaitable(result):
                 result = await result
             if digest(msg) != before:
@@ -347,6 +593,47 @@ class Subscription(Endpoint, Generic[M]):
         self.node.destroy_subscription(self)
 
 
+def _takes_message_info(callback: Callable[..., Any]) -> bool:
+    """rclpy's rule (``Subscription.callback`` setter): a callback that can be called with one
+    argument gets the message; else one callable with two gets ``(msg, MessageInfo)``; else
+    ``RuntimeError``."""
+    try:
+        sig = inspect.signature(callback)
+    except (TypeError, ValueError):
+        return False
+    try:
+        sig.bind(object())
+        return False
+    except TypeError:
+        pass
+    try:
+        sig.bind(object(), object())
+        return True
+    except TypeError:
+        pass
+    raise RuntimeError(
+        "Subscription.__init__(): callback should be either be callable with one argument"
+        "(to get only the message) or two (to get message and message info)"
+    )
+
+
+def _with_info(callback: Callable[..., Any]) -> Callable[[tuple[Any, Any]], Any]:
+    def with_info(pair: tuple[Any, Any]) -> Any:
+        return callback(pair[0], pair[1])
+
+    return with_info
+
+
+def _raw(callback: Callable[..., Any]) -> Callable[..., Any]:
+    """``create_subscription(raw=True)``: the callback gets the message's CDR bytes, as rclpy's."""
+    from .msgs import serialize
+
+    def raw(msg: Any, *info: Any) -> Any:
+        return callback(serialize(msg), *info)
+
+    return raw
+
+
 class MessageStream(Generic[M]):
     """``async for msg in node.subscribe(Type, "/topic")``: a subscription read as an async iterator.
 
@@ -364,11 +651,17 @@ class MessageStream(Generic[M]):
 
     async def __anext__(self) -> M:
         sub = self.subscription
-        while not sub._queue:
-            if sub.destroyed:
-                raise StopAsyncIteration
-            await sub._wait()
-        return sub._queue.popleft()
+        while True:
+            while not sub._queue:
+                if sub.destroyed:
+                    raise StopAsyncIteration
+                await sub._wait()
+            msg = sub._queue.popleft()
+            if sub._infos is not None:
+                msg = sub._take_info(msg)
+                if msg is _EXPIRED:
+                    continue
+            return msg
 
     async def __aenter__(self) -> MessageStream[M]:
         return self

@@ -6,16 +6,19 @@ import enum
 import warnings
 from dataclasses import dataclass
 
-from ._time import Duration
+from ._time import Duration, Infinite
 
 __all__ = [
     "DurabilityPolicy",
     "HistoryPolicy",
+    "LivelinessPolicy",
     "QoSPolicyEnum",
+    "QoSPolicyKind",
     "QoSPresetProfiles",
     "QoSProfile",
     "ReliabilityPolicy",
     "qos_profile_sensor_data",
+    "qos_policy_name_from_kind",
     "qos_profile_system_default",
     "to_qos_profile",
 ]
@@ -56,6 +59,49 @@ class HistoryPolicy(QoSPolicyEnum):
     KEEP_ALL = 2
 
 
+class LivelinessPolicy(QoSPolicyEnum):
+    """How a publisher shows it is alive (values as rmw's ``rmw_qos_liveliness_policy_e``).
+
+    ``AUTOMATIC``: the runtime does, for as long as the publisher exists.
+    ``MANUAL_BY_TOPIC``: the publisher must publish or call ``assert_liveliness()``
+    at least once per ``liveliness_lease_duration``.
+    """
+
+    AUTOMATIC = 1
+    MANUAL_BY_TOPIC = 3
+
+
+class QoSPolicyKind(enum.IntEnum):
+    """Which policy made two endpoints incompatible (rclpy's and rmw's values)."""
+
+    INVALID = 1 << 0
+    DURABILITY = 1 << 1
+    DEADLINE = 1 << 2
+    LIVELINESS = 1 << 3
+    RELIABILITY = 1 << 4
+    HISTORY = 1 << 5
+    LIFESPAN = 1 << 6
+    DEPTH = 1 << 7
+    LIVELINESS_LEASE_DURATION = 1 << 8
+    AVOID_ROS_NAMESPACE_CONVENTIONS = 1 << 9
+
+
+def qos_policy_name_from_kind(policy_kind: QoSPolicyKind | int) -> str:
+    """The policy's name (``"DURABILITY"``), as rclpy's."""
+    return QoSPolicyKind(policy_kind).name
+
+
+def finite_ns(duration: Duration | None) -> int | None:
+    """A deadline, lifespan or lease in nanoseconds, or None when it is infinite (None, zero or
+    ``Infinite``: rmw's "default" and "infinite" both mean no limit)."""
+    if duration is None:
+        return None
+    ns = duration.nanoseconds
+    if ns <= 0 or ns >= Infinite.nanoseconds:
+        return None
+    return ns
+
+
 @dataclass(frozen=True, slots=True)
 class QoSProfile:
     """A QoS profile, as rclpy's, with ROS 2 defaults (reliable, volatile, keep last 10)."""
@@ -66,12 +112,15 @@ class QoSProfile:
     depth: int = 10
     deadline: Duration | None = None
     lifespan: Duration | None = None
+    liveliness: LivelinessPolicy = LivelinessPolicy.AUTOMATIC
+    liveliness_lease_duration: Duration | None = None
 
     def __post_init__(self) -> None:
         for field, enum_type in (
             ("reliability", ReliabilityPolicy),
             ("durability", DurabilityPolicy),
             ("history", HistoryPolicy),
+            ("liveliness", LivelinessPolicy),
         ):
             value = getattr(self, field)
             if not isinstance(value, enum_type):
@@ -87,7 +136,7 @@ class QoSProfile:
             # rclpy's words (rclpy/qos.py QoSProfile.__init__); the profile is kept
             warnings.warn("A zero depth with KEEP_LAST doesn't make sense; no data could be stored. "
                           "This will be interpreted as SYSTEM_DEFAULT", UserWarning, stacklevel=3)
-        for field in ("deadline", "lifespan"):
+        for field in ("deadline", "lifespan", "liveliness_lease_duration"):
             value = getattr(self, field)
             if value is not None and not isinstance(value, Duration):
                 raise ValueError(f"QoSProfile.{field}: expected a Duration or None, got {value!r}")
@@ -150,24 +199,44 @@ def to_qos_profile(qos: QoSProfile | int) -> QoSProfile:
     raise TypeError(f"expected a QoSProfile or an int depth, got {qos!r}")
 
 
-def incompatibility(offered: QoSProfile, requested: QoSProfile) -> str | None:
-    """Why a publisher offering ``offered`` cannot serve a subscription requesting ``requested``.
+def incompatible_policy(offered: QoSProfile, requested: QoSProfile) -> tuple[QoSPolicyKind, str] | None:
+    """The policy for which a publisher offering ``offered`` cannot serve a subscription
+    requesting ``requested``, and why; None when they connect.
 
-    ROS 2 (DDS request/offer) rules: the subscription must not be stricter than the publisher.
-    Returns None when they connect.
+    ROS 2 (DDS request/offer) rules: the subscription must not be stricter than the publisher
+    in reliability, durability, deadline, liveliness kind and liveliness lease.
     """
     if (
         offered.reliability is ReliabilityPolicy.BEST_EFFORT
         and requested.reliability is ReliabilityPolicy.RELIABLE
     ):
-        return "reliability: publisher offers BEST_EFFORT, subscription requests RELIABLE"
+        return QoSPolicyKind.RELIABILITY, "reliability: publisher offers BEST_EFFORT, subscription requests RELIABLE"
     if (
         offered.durability is DurabilityPolicy.VOLATILE
         and requested.durability is DurabilityPolicy.TRANSIENT_LOCAL
     ):
-        return "durability: publisher offers VOLATILE, subscription requests TRANSIENT_LOCAL"
-    if requested.deadline is not None and (
-        offered.deadline is None or offered.deadline > requested.deadline
-    ):
-        return "deadline: publisher offers a longer deadline than the subscription requests"
+        return QoSPolicyKind.DURABILITY, "durability: publisher offers VOLATILE, subscription requests TRANSIENT_LOCAL"
+    requested_deadline = finite_ns(requested.deadline)
+    if requested_deadline is not None:
+        offered_deadline = finite_ns(offered.deadline)
+        if offered_deadline is None or offered_deadline > requested_deadline:
+            return QoSPolicyKind.DEADLINE, "deadline: publisher offers a longer deadline than the subscription requests"
+    if offered.liveliness < requested.liveliness:
+        return QoSPolicyKind.LIVELINESS, (
+            f"liveliness: publisher offers {offered.liveliness.name}, subscription requests {requested.liveliness.name}"
+        )
+    requested_lease = finite_ns(requested.liveliness_lease_duration)
+    if requested_lease is not None:
+        offered_lease = finite_ns(offered.liveliness_lease_duration)
+        if offered_lease is None or offered_lease > requested_lease:
+            return QoSPolicyKind.LIVELINESS, (
+                "liveliness: publisher offers a longer liveliness lease than the subscription requests"
+            )
     return None
+
+
+def incompatibility(offered: QoSProfile, requested: QoSProfile) -> str | None:
+    """Why a publisher offering ``offered`` cannot serve a subscription requesting ``requested``
+    (see :func:`incompatible_policy`); None when they connect."""
+    found = incompatible_policy(offered, requested)
+    return None if found is None else found[1]

@@ -74,7 +74,9 @@ class Runtime:
     debug_messages
         Check the zero-copy contract: log an error when a publisher changes a message after
         publishing it, or a subscription callback changes the message it received
-        (development aid; it pickles every message).
+        (development aid; it pickles every message); and, while this runtime runs, check
+        every assignment to a message field for type and range as rclpy's generated
+        setters do (``msg.data = 'five'`` on an Int32 raises TypeError naming the field).
     shutdown_timeout
         Seconds the orderly shutdown (``on_shutdown`` hooks, stopping nodes and loops) may
         take. After a SIGINT/SIGTERM, once it has passed (or on a second signal), what is
@@ -145,6 +147,7 @@ class Runtime:
         self.use_sim_time = use_sim_time
         self.clock = Clock(ClockType.ROS_TIME, use_sim_time=use_sim_time)
         self._bus = Bus(strict_qos=strict_qos, debug_messages=debug_messages)
+        self._assignment_checks = False  # enable_assignment_checks() is ours to undo
         self._bus.transport = self.transport
         self._nodes: list[Node] = []
         self._pending: list[tuple[Node, str]] = []
@@ -210,6 +213,11 @@ class Runtime:
             )
             self._bus.add_subscription(self._clock_tap)
         self._state = "running"
+        if self._bus.debug_messages:
+            from .msgs._classgen import enable_assignment_checks
+
+            enable_assignment_checks()  # message field assignments are type and range checked
+            self._assignment_checks = True
         try:
             self.add_nodes([*self._pending, *built])
         except BaseException:
@@ -453,6 +461,11 @@ class Runtime:
         if self._state in ("closing", "closed"):
             return
         self._state = "closing"
+        if self._assignment_checks:
+            from .msgs._classgen import disable_assignment_checks
+
+            disable_assignment_checks()
+            self._assignment_checks = False
         loop = asyncio.get_running_loop()
         deadline = loop.time() + self.shutdown_timeout
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from .._qos import DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile, ReliabilityPolicy
 
 __all__ = ["BagError", "TopicInfo", "qos_from_bag", "qos_to_bag", "write_metadata"]
 
@@ -48,8 +48,8 @@ def qos_to_bag(qos: QoSProfile) -> Any:
         QosDurability.TRANSIENT_LOCAL if qos.durability is DurabilityPolicy.TRANSIENT_LOCAL else QosDurability.VOLATILE,
         duration(qos.deadline),
         duration(qos.lifespan),
-        QosLiveliness.AUTOMATIC,
-        QosTime(0, 0),
+        QosLiveliness.MANUAL_BY_TOPIC if qos.liveliness is LivelinessPolicy.MANUAL_BY_TOPIC else QosLiveliness.AUTOMATIC,
+        duration(qos.liveliness_lease_duration),
         False,
     )
 

@@ -16,7 +16,7 @@ import numpy as np
 from ._spec import _INT_RANGES, ARRAY, PRIMITIVES, SCALAR, FieldType, MsgSpec
 
 __all__ = ["Action", "FrozenList", "Message", "ReadOnlyMessageError", "Service", "build_class",
-           "freezer"]
+           "disable_assignment_checks", "enable_assignment_checks", "freezer"]
 
 _ndarray = np.ndarray
 
@@ -26,10 +26,12 @@ class Message:
 
     Constructor arguments are checked as rclpy's generated classes check them: type, integer
     and float32 range, string bounds, item types of sequences; a bad one raises TypeError or
-    ValueError naming the field. Assignments after construction are not checked.
+    ValueError naming the field. Assignments after construction are checked the same way
+    while a ``Runtime(debug_messages=True)`` runs, and cost nothing otherwise.
 
     rclpy difference: float fields accept ints and numpy numbers (stored as float); rclpy
-    accepts only float. Assignment is not checked (rclpy checks every assignment).
+    accepts only float. Assignment is checked only under ``debug_messages`` (rclpy checks
+    every assignment).
     """
 
     __slots__ = ()
@@ -427,6 +429,74 @@ def _copy_expr(spec: MsgSpec, cls_name: str, src: str, ns: dict[str, Any],
     return f"{cls_name}({', '.join([*args, 'True'])})"
 
 
+#: Every generated message class, for switching assignment checks on and off.
+_CLASSES: list[type] = []
+#: How many users (runtimes with ``debug_messages``) want assignment checks now.
+_CHECK_USERS = 0
+
+
+def enable_assignment_checks() -> None:
+    """Check every assignment to a message field as the constructor checks its argument
+    (``msg.data = 'five'`` on an Int32 raises TypeError naming the field), in every message
+    class, until as many :func:`disable_assignment_checks` calls. Process-wide: message
+    classes are shared."""
+    global _CHECK_USERS
+    _CHECK_USERS += 1
+    if _CHECK_USERS == 1:
+        for cls in _CLASSES:
+            _install_checks(cls)
+
+
+def disable_assignment_checks() -> None:
+    """Undo one :func:`enable_assignment_checks`; the last one restores unchecked (free) assignment."""
+    global _CHECK_USERS
+    if _CHECK_USERS == 0:
+        return
+    _CHECK_USERS -= 1
+    if _CHECK_USERS == 0:
+        for cls in _CLASSES:
+            if "__setattr__" in cls.__dict__:
+                del cls.__setattr__  # type: ignore[misc]
+
+
+def _field_checker(spec: MsgSpec, i: int, field_classes: dict[int, type]) -> Callable[[Any], Any]:
+    f = spec.fields[i]
+    t: FieldType = f.type
+    where = f"{spec.name}.{f.name}"
+    if t.kind == SCALAR and not t.is_message:
+        if t.base in ("float32", "float64"):
+            return lambda v: check_float(v, where, t.base)
+        if t.base == "bool":
+            return lambda v: check_bool(v, where)
+        if t.is_string:
+            return lambda v: check_str(v, where, t.string_bound or 0)
+        return lambda v: check_int(v, where, t.base)
+    if t.kind == SCALAR:
+        nested = field_classes[i]
+        return lambda v: check_message(v, nested, where)
+    if t.is_primitive:
+        dtype = _DTYPES[t.base]
+        if t.kind == ARRAY:
+            return lambda v: checked_fixed_array(v, dtype, t.count, where)
+        return lambda v: checked_array(v, dtype, where)
+    if t.is_string:
+        return lambda v: check_list(v, str, where, "str")
+    item = field_classes[i]
+    return lambda v: check_list(v, item, where, t.base)
+
+
+def _install_checks(cls: Any) -> None:
+    checkers = {f.name: _field_checker(cls._spec, i, cls._field_classes) for i, f in enumerate(cls._spec.fields)}
+    get_checker = checkers.get
+    set_field = object.__setattr__
+
+    def __setattr__(self: Any, name: str, value: Any) -> None:
+        check = get_checker(name)
+        set_field(self, name, value if check is None else check(value))
+
+    cls.__setattr__ = __setattr__
+
+
 def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> type:
     ns: dict[str, Any] = {
         "_Message": Message, "_zeros": np.zeros, "_empty": np.empty, "_arr": as_array,
@@ -450,6 +520,10 @@ def _message_class(spec: MsgSpec, get: Callable[[str], type], qualname: str) -> 
     cls.__doc__ = f"ROS 2 message {spec.name}."
     cls._field_types = {f.name: str(f.type) for f in spec.fields}  # type: ignore[attr-defined]
     cls._spec = spec  # type: ignore[attr-defined]
+    cls._field_classes = {i: ns[f"_T{i}"] for i in range(len(spec.fields)) if f"_T{i}" in ns}  # type: ignore[attr-defined]
+    _CLASSES.append(cls)
+    if _CHECK_USERS:
+        _install_checks(cls)
     return cls
 
 

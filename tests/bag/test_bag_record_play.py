@@ -130,3 +130,15 @@ def test_a_directory_that_is_not_a_bag_gets_one_clear_error(tmp_path: Path) -> N
         BagReader(tmp_path)
     with pytest.raises(BagError, match="no such bag directory"):
         BagReader(tmp_path / "missing")
+
+
+def test_offered_qos_keeps_liveliness_and_lease():
+    from rosbags.interfaces import QosLiveliness
+
+    from aiorobot import Duration, LivelinessPolicy, QoSProfile
+    from aiorobot.bag._metadata import qos_to_bag
+
+    qos = qos_to_bag(QoSProfile(liveliness=LivelinessPolicy.MANUAL_BY_TOPIC, liveliness_lease_duration=Duration(seconds=2.5)))
+    assert qos.liveliness == QosLiveliness.MANUAL_BY_TOPIC
+    assert (qos.liveliness_lease_duration.sec, qos.liveliness_lease_duration.nsec) == (2, 500_000_000)
+    assert qos_to_bag(QoSProfile()).liveliness == QosLiveliness.AUTOMATIC

@@ -3,6 +3,7 @@
 import logging
 
 import numpy as np
+import pytest
 
 from aiorobot import Node, Runtime
 from aiorobot.msgs.sensor_msgs import Image
@@ -70,3 +71,42 @@ async def test_well_behaved_graph_reports_nothing(caplog):
         await settle(rt)
     assert [m.data for m in got] == list(range(20))
     assert _errors(caplog) == []
+
+
+async def test_assignment_is_type_and_range_checked_under_debug_messages():
+    # rclpy's generated setters (rosidl_generator_py _msg.py.em): a wrong type raises TypeError
+    # naming the field, an out-of-range integer ValueError; off again when the runtime closes
+    from aiorobot.msgs.geometry_msgs import Twist, Vector3
+    from aiorobot.msgs.sensor_msgs import JointState
+    from aiorobot.msgs.std_msgs import Int32, UInt8
+
+    msg = Int32()
+    async with Runtime(debug_messages=True, handle_signals=False):
+        with pytest.raises(TypeError, match=r"std_msgs/msg/Int32\.data expects an int"):
+            msg.data = "five"
+        with pytest.raises(ValueError, match=r"std_msgs/msg/Int32\.data: 1099511627776 is out of range"):
+            msg.data = 2**40
+        with pytest.raises(ValueError, match="out of range for uint8"):
+            UInt8().data = -1
+        with pytest.raises(TypeError, match=r"geometry_msgs/msg/Twist\.linear expects a geometry_msgs/msg/Vector3"):
+            Twist().linear = 5
+        with pytest.raises(TypeError, match=r"JointState\.name\[1\] expects a str"):
+            JointState().name = ["a", 2]
+        msg.data = 7  # good values pass, and are stored as the constructor stores them
+        twist = Twist(linear=Vector3(x=1))
+        twist.linear.y = 2  # an int for a float field, as the constructor takes
+        assert msg.data == 7 and twist.linear.y == 2.0 and type(twist.linear.y) is float
+        state = JointState()
+        state.position = [1, 2]
+        assert state.position.dtype.name == "float64"
+    msg.data = "unchecked again"  # no runtime with debug_messages: assignment is a plain slot write
+    assert msg.data == "unchecked again"
+    assert "__setattr__" not in Int32.__dict__
+
+
+async def test_assignment_is_not_checked_without_debug_messages(runtime):
+    from aiorobot.msgs.std_msgs import Int32
+
+    msg = Int32()
+    msg.data = "five"
+    assert msg.data == "five" and "__setattr__" not in Int32.__dict__

@@ -122,3 +122,36 @@ def test_subscription_stricter_than_publisher_is_incompatible(pub, sub, policy):
 )
 def test_publisher_stricter_than_subscription_connects(pub, sub):
     assert incompatibility(pub, sub) is None
+
+
+def test_liveliness_policy_and_lease():
+    # rclpy test/test_qos.py: policies accept their int values; rmw's liveliness values
+    from aiorobot import LivelinessPolicy
+
+    qos = QoSProfile(liveliness=3, liveliness_lease_duration=Duration(seconds=1))
+    assert qos.liveliness is LivelinessPolicy.MANUAL_BY_TOPIC
+    assert QoSProfile().liveliness is LivelinessPolicy.AUTOMATIC
+    assert LivelinessPolicy.get_from_short_key("manual_by_topic") == 3
+    with pytest.raises(ValueError, match="QoSProfile.liveliness_lease_duration: expected a Duration"):
+        QoSProfile(liveliness_lease_duration=1.0)
+    with pytest.raises(ValueError, match="QoSProfile.liveliness: expected a LivelinessPolicy"):
+        QoSProfile(liveliness=2)
+
+
+def test_zero_and_infinite_durations_mean_no_limit():
+    from aiorobot import Infinite
+    from aiorobot._qos import finite_ns
+
+    assert finite_ns(None) is None and finite_ns(Duration()) is None and finite_ns(Infinite) is None
+    assert finite_ns(Duration(seconds=2)) == 2_000_000_000
+    # a requested deadline of zero (rmw's "default") is no request at all
+    assert incompatibility(QoSProfile(), QoSProfile(deadline=Duration())) is None
+
+
+def test_qos_policy_kind_values_and_names():
+    # rclpy qos.py QoSPolicyKind (rmw/incompatible_qos_events_statuses.h) and qos_policy_name_from_kind
+    from aiorobot import QoSPolicyKind, qos_policy_name_from_kind
+
+    assert [int(k) for k in QoSPolicyKind] == [1 << i for i in range(10)]
+    assert qos_policy_name_from_kind(QoSPolicyKind.DURABILITY) == "DURABILITY"
+    assert qos_policy_name_from_kind(1 << 4) == "RELIABILITY"
