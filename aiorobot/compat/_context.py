@@ -224,7 +224,14 @@ class Context:
             task.add_done_callback(lambda _t: self.wake())
 
         loop.call_soon(start)
-        self.spin_until(self.executor, done, None, raise_on_shutdown=False)
+        try:
+            self.spin_until(self.executor, done, None, raise_on_shutdown=False)
+        except BaseException:
+            if task is not None:
+                task.cancel()
+            else:
+                coro.close()
+            raise
         if task is None or not task.done():
             if task is not None:
                 task.cancel()

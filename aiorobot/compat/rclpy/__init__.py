@@ -129,7 +129,7 @@ def __getattr__(name: str) -> Any:
 
 _SUBMODULES = frozenset(
     {
-        "action", "callback_groups", "client", "clock", "duration", "exceptions", "executors", "lifecycle",
+        "action", "callback_groups", "client", "clock", "duration", "exceptions", "executors",
         "logging", "node", "parameter", "publisher", "qos", "service", "subscription", "task", "time",
         "timer", "utilities", "signals", "context",
     }
