@@ -102,7 +102,7 @@ class AliasFinder(importlib.abc.MetaPathFinder):
                 module = importlib.import_module(target_name)
             except ModuleNotFoundError as err:
                 if err.name == target_name:
-                    return None
+                    raise not_provided(fullname) from None
                 raise
             return importlib.util.spec_from_loader(fullname, _Existing(module), is_package=hasattr(module, "__path__"))
         if top in self.packages():

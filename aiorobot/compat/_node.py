@@ -61,7 +61,7 @@ class Client(_services.Client):
         self._check_request(request)
         ctx = self._context
         fut = future_of(self._call_when_ready(request), None if _services._in_loop() else self.node._loop)
-        fut.add_done_callback(lambda _f: ctx.wake())
+        fut.add_done_callback(lambda _f: ctx.callback_finished())
         return fut
 
     def call(self, request: Any, timeout_sec: float | None = None) -> Any:  # type: ignore[override]

@@ -18,8 +18,6 @@ CASES = [
      ['Publishing: "Hello World: 1"', "native heard: Hello World: 1"], 1, False),
     ("examples_rclpy_minimal_publisher/publisher_local_function.py", ("Listener",),
      ['Publishing: "Hello World: 1"', "native heard: Hello World: 1"], 1, False),
-    ("examples_rclpy_minimal_publisher/publisher_old_school.py", ("Listener",),
-     ['Publishing: "Hello World: 1"', "native heard: Hello World: 1"], 1, False),
     ("examples_rclpy_minimal_subscriber/subscriber_member_function.py", ("Talker",),
      ['I heard: "native'], 3, False),
     ("examples_rclpy_minimal_subscriber/subscriber_lambda.py", ("Talker",), ['I heard: "native'], 3, False),
@@ -57,3 +55,12 @@ def test_upstream_program_runs_unmodified(script, nodes, needles, count, ends):
     code = program.finish() if ends else program.stop()
     assert code == 0, f"exit status {code}; output:\n{program.output}"
     assert "Traceback" not in program.output, program.output
+
+
+def test_a_missing_rclpy_name_fails_at_that_name_with_the_docs_link(tmp_path):
+    script = tmp_path / "uses_lifecycle.py"
+    script.write_text("import rclpy\nfrom rclpy.lifecycle import LifecycleNode\n")
+    program = Program(str(script))
+    code = program.finish()
+    assert code == 1
+    assert "aiorobot does not provide rclpy.lifecycle yet; see https://" in program.output

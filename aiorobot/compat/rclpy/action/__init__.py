@@ -71,7 +71,7 @@ class ActionClient(_actions.ActionClient):
             raise TypeError(f"send_goal_async expects {self.action_type.Goal.__msgtype__}, got {type(goal).__name__}")
         coro = _actions.ActionClient.send_goal(self, goal, _wrap(self.node, feedback_callback), goal_uuid=goal_uuid)
         fut = future_of(coro, self._loop_for_futures())
-        fut.add_done_callback(lambda _f: ctx.wake())
+        fut.add_done_callback(lambda _f: ctx.callback_finished())
         return fut
 
     def send_goal(self, goal: Any, **kwargs: Any) -> Any:  # type: ignore[override]
