@@ -406,6 +406,27 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             if self._runtime is not None:
                 self._runtime._bus.services.remove(client)
 
+    def destroy_node(self) -> None:
+        """Take the node out of the graph, as rclpy's ``destroy_node``; calling it again does nothing.
+
+        A node in a runtime is removed from it (its endpoints leave at once, its tasks end
+        on its loop); a node never added has its publishers, subscriptions, timers,
+        services and clients destroyed.
+        """
+        runtime = self._runtime
+        if runtime is not None and self in runtime._nodes:
+            runtime.remove_node(self)
+        for pub in list(self._publishers):
+            self.destroy_publisher(pub)
+        for sub in list(self._subscriptions):
+            self.destroy_subscription(sub)
+        for timer in list(self._timers):
+            self.destroy_timer(timer)
+        for service in list(self._services):
+            self.destroy_service(service)
+        for client in list(self._clients):
+            self.destroy_client(client)
+
     @property
     def publishers(self) -> tuple[Publisher[Any], ...]:
         return tuple(self._publishers)

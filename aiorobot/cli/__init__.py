@@ -36,6 +36,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
     "tf": ("aiorobot.cli._tf_cmd", "transforms of the running graph: echo (tf2_echo), tree (view_frames)"),
     "interface": ("aiorobot.cli._interface_cmd", "message, service and action types: list, packages, package, show"),
+    "exec": ("aiorobot.cli._exec", "run an unmodified rclpy program (ROS 2 Python) on aiorobot"),
 }
 
 

@@ -92,7 +92,14 @@ class FrozenList(list):  # type: ignore[type-arg]
 
 
 def _readonly_array(a: np.ndarray) -> np.ndarray:
-    """What a subscriber gets for an array field: large ones shared, small ones copied; both read-only."""
+    """What a subscriber gets for an array field: large ones shared, small ones copied; both read-only.
+
+    A list assigned to the field (rclpy code does ``msg.sequence = [0, 1]``) is copied into an array.
+    """
+    if not isinstance(a, np.ndarray):
+        b = np.array(a)
+        b.flags.writeable = False
+        return b
     if not a.flags.writeable:
         return a
     if a.nbytes >= SHARE_BYTES:

@@ -1,0 +1,58 @@
+"""``aiorobot exec script.py [args...]``: run an unmodified rclpy program on aiorobot."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+
+__all__ = ["add_arguments", "main", "run_script"]
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--transport", choices=("local", "zenoh"), default="local",
+        help="local: the program's nodes talk in-process (default); zenoh: with other processes "
+        "(ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE apply, as in rmw_zenoh)",
+    )
+    parser.add_argument(
+        "--node", action="append", default=[], metavar="MODULE:CLASS",
+        help="also run this aiorobot node in the program's graph (repeatable): mixed graphs",
+    )
+    parser.add_argument("script", help="a ROS 2 Python program (rclpy); it runs as __main__")
+    parser.add_argument("args", nargs=argparse.REMAINDER, help="its arguments (--ros-args ... included)")
+
+
+def main(args: argparse.Namespace) -> int:
+    return run_script([args.script, *args.args], prog="aiorobot exec", transport=args.transport, nodes=args.node)
+
+
+def run_script(argv: Sequence[str], *, prog: str, transport: str = "local", nodes: Sequence[str] = ()) -> int:
+    """Run ``argv[0]`` with the rclpy aliases; its exit status (SystemExit honoured)."""
+    if not argv:
+        print(f"{prog}: error: expected a script to run (e.g. {prog} talker.py)", file=sys.stderr)
+        return 2
+    script, *rest = argv
+    if not os.path.isfile(script):
+        print(f"{prog}: error: expected a Python file, found {script!r} (no such file)", file=sys.stderr)
+        return 2
+    from .._ros_args import RosArgsError, parse_ros_args
+    from ..compat import run_path
+    from ..compat._context import settings
+
+    for spec in nodes:
+        module_name, sep, attr = spec.partition(":")
+        if not sep or not module_name or not attr:
+            print(f"{prog}: error: --node: expected MODULE:CLASS, found {spec!r}", file=sys.stderr)
+            return 2
+    settings.transport = transport
+    settings.nodes = list(nodes)
+
+    try:
+        parse_ros_args(rest)
+    except RosArgsError as err:
+        print(f"{prog}: error: {err}", file=sys.stderr)
+        return 2
+    run_path(script, rest)
+    return 0

@@ -1,0 +1,351 @@
+"""rclpy's context on aiorobot: one :class:`~aiorobot.Runtime` driven by whichever thread spins.
+
+``rclpy.init`` builds an event loop and enters a runtime on it, without running it.
+Spinning (``rclpy.spin``, ``spin_once``, ``spin_until_future_complete``, a blocking
+``client.call``) runs that loop in the calling thread until its condition holds, so
+plain-function callbacks run in the spinning thread as rclpy's SingleThreadedExecutor
+runs them. Between spins nothing runs. SIGINT shuts the context down and raises
+``KeyboardInterrupt`` in the main thread; SIGTERM shuts it down, so a spin raises
+``ExternalShutdownException``; both as rclpy.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Coroutine
+from typing import Any, TypeVar
+
+from .._ros_args import RosArgs, parse_ros_args
+from .._runtime import Runtime
+
+__all__ = ["Context", "ExternalShutdownException", "default_context", "settings"]
+
+
+class _Settings:
+    """What ``aiorobot exec`` sets before the program runs: transport, extra native nodes."""
+
+    transport: str = "local"
+    #: ``module:Class`` of aiorobot nodes added to the runtime at ``rclpy.init`` (mixed graphs)
+    nodes: list[str] = []
+
+
+settings = _Settings()
+
+T = TypeVar("T")
+
+
+class ExternalShutdownException(Exception):
+    """The context was shut down (by a signal, or another thread) while spinning (rclpy's)."""
+
+
+class Context:
+    """rclpy's ``Context``: ``init``, ``ok``, ``shutdown``, ``try_shutdown``, ``on_shutdown``."""
+
+    def __init__(self) -> None:
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self.runtime: Runtime | None = None
+        self.argv: list[str] = []
+        self.ros_args: RosArgs = RosArgs()
+        self._ok = False
+        self._closed = True
+        self._lock = threading.RLock()
+        self._spin_lock = threading.Lock()
+        self._spin_thread: int | None = None
+        self._waiter: asyncio.Future[None] | None = None
+        self._local = threading.local()
+        self._on_shutdown: list[Callable[[], Any]] = []
+        self._saved_handlers: dict[int, Any] = {}
+        #: the executor whose spin is running the loop (decides where plain callbacks run)
+        self.executor: Any = None
+        self.callbacks_done = 0
+
+    def __repr__(self) -> str:
+        return f"<rclpy Context {'ok' if self._ok else 'shut down'} (aiorobot)>"
+
+    # -- rclpy's surface -----------------------------------------------------------
+
+    def init(self, args: list[str] | None = None, *, domain_id: int | None = None) -> None:
+        with self._lock:
+            if self._ok or not self._closed:
+                raise RuntimeError("rclpy.init: the context is already initialized; call rclpy.shutdown() first")
+            argv = list(sys.argv if args is None else args)
+            self.ros_args = parse_ros_args(argv)
+            self.argv = argv
+            if domain_id is None:
+                domain_id = int(os.environ.get("ROS_DOMAIN_ID", "0") or 0)
+            loop = asyncio.new_event_loop()
+            runtime = Runtime(transport=settings.transport, domain_id=domain_id, handle_signals=False)
+            loop.run_until_complete(runtime.__aenter__())
+            for spec in settings.nodes:
+                runtime.add_node(_build_node(spec))
+            # The loop only runs while a thread spins, and rclpy callbacks may block: the
+            # stall watchdog would report every pause between spins, so it is off here.
+            runtime._watchdog.unwatch(loop)
+            self.loop, self.runtime = loop, runtime
+            self._ok, self._closed = True, False
+            self._install_signal_handlers()
+
+    def ok(self) -> bool:
+        return self._ok
+
+    def shutdown(self) -> None:
+        """Shut down; ``RuntimeError`` when already shut down (rclpy raises ``RCLError`` there)."""
+        with self._lock:
+            if not self._ok:
+                raise RuntimeError(
+                    "rclpy.shutdown: the context is already shut down (or was never initialized); "
+                    "rclpy.try_shutdown() does nothing in that case"
+                )
+            self._request_shutdown()
+        self._close_if_idle()
+
+    def try_shutdown(self) -> None:
+        with self._lock:
+            if self._ok:
+                self._request_shutdown()
+        self._close_if_idle()
+
+    def on_shutdown(self, callback: Callable[[], Any]) -> None:
+        self._on_shutdown.append(callback)
+
+    # -- running the loop ---------------------------------------------------------------
+
+    def in_callback(self) -> bool:
+        return bool(getattr(self._local, "depth", 0))
+
+    def call_as_callback(self, fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
+        self._local.depth = getattr(self._local, "depth", 0) + 1
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            self._local.depth -= 1
+
+    def callback_finished(self) -> None:
+        self.callbacks_done += 1
+        self.wake()
+
+    def wake(self) -> None:
+        """Make the spin in progress re-check its condition (from any thread)."""
+        loop, waiter = self.loop, self._waiter
+        if loop is None or waiter is None or loop.is_closed():
+            return
+        if threading.get_ident() == self._spin_thread:
+            if not waiter.done():
+                waiter.set_result(None)
+        else:
+            loop.call_soon_threadsafe(_resolve, waiter)
+
+    def require_ok(self, what: str) -> None:
+        if not self._ok or self.loop is None:
+            from .rclpy.exceptions import NotInitializedException
+
+            raise NotInitializedException(f"{what}: rclpy.init() has not been called (or rclpy.shutdown() was)")
+
+    def spin_until(
+        self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool
+    ) -> bool:
+        """Run the loop in this thread until ``done()`` or ``timeout_sec``; whether ``done()`` held."""
+        self.require_ok("spin")
+        loop = self.loop
+        assert loop is not None
+        if loop.is_running():
+            if self._spin_thread == threading.get_ident():
+                raise RuntimeError(
+                    "spin called from inside a callback: the executor is already spinning in this thread "
+                    "(rclpy would deadlock here; use call_async / send_goal_async and a done callback)"
+                )
+        if not self._spin_lock.acquire(blocking=False):
+            raise RuntimeError("the executor is already spinning in another thread (rclpy raises here too)")
+        shut_by_callback = False
+        try:
+            self._bind_thread()
+            previous, self.executor = self.executor, executor
+
+            async def run() -> bool:
+                nonlocal shut_by_callback
+                deadline = None if timeout_sec is None or timeout_sec < 0 else loop.time() + timeout_sec
+                await asyncio.sleep(0)
+                while True:
+                    if done():
+                        return True
+                    if not self._ok:
+                        shut_by_callback = getattr(self, "_shutdown_from_callback", False)
+                        return False
+                    remaining = None if deadline is None else deadline - loop.time()
+                    if remaining is not None and remaining <= 0:
+                        return False
+                    self._waiter = loop.create_future()
+                    try:
+                        await asyncio.wait_for(asyncio.shield(self._waiter), remaining)
+                    except TimeoutError:
+                        pass
+                    finally:
+                        self._waiter = None
+
+            try:
+                result = loop.run_until_complete(run())
+            finally:
+                self.executor = previous
+                self._spin_thread = None
+        finally:
+            self._spin_lock.release()
+        if not self._ok:
+            self._close_if_idle()
+            if raise_on_shutdown and not shut_by_callback and not result:
+                raise ExternalShutdownException()
+        return result
+
+    def run_sync(self, coro: Coroutine[Any, Any, T], what: str) -> T:
+        """Run ``coro`` to its end from synchronous code (rclpy's blocking calls)."""
+        self.require_ok(what)
+        loop = self.loop
+        assert loop is not None
+        if loop.is_running() or self._spin_lock.locked():
+            if self._spin_thread == threading.get_ident():
+                coro.close()
+                raise RuntimeError(
+                    f"{what} blocks until the executor handles the reply, but it was called from a callback "
+                    "the executor is running in this thread: it would deadlock (as in rclpy). Use the "
+                    "_async form with a done callback, or a MultiThreadedExecutor and a ReentrantCallbackGroup"
+                )
+            return asyncio.run_coroutine_threadsafe(coro, loop).result()
+        task: asyncio.Future[T] | None = None
+
+        def done() -> bool:
+            return task is not None and task.done()
+
+        def start() -> None:
+            nonlocal task
+            task = asyncio.ensure_future(coro, loop=loop)
+            task.add_done_callback(lambda _t: self.wake())
+
+        loop.call_soon(start)
+        try:
+            self.spin_until(self.executor, done, None, raise_on_shutdown=False)
+        except BaseException:
+            if task is not None:
+                task.cancel()
+            else:
+                coro.close()
+            raise
+        if task is None or not task.done():
+            if task is not None:
+                task.cancel()
+            else:
+                coro.close()
+            from .rclpy.exceptions import NotInitializedException
+
+            raise NotInitializedException(f"{what}: the context was shut down before it finished")
+        return task.result()
+
+    # -- internals ------------------------------------------------------------------
+
+    def _bind_thread(self) -> None:
+        """Make the calling thread the loop's: aiorobot checks thread ids to choose thread-safe paths."""
+        tid = threading.get_ident()
+        self._spin_thread = tid
+        runtime = self.runtime
+        if runtime is None or runtime._thread_id == tid:
+            return
+        runtime._thread_id = tid
+        for node in runtime._nodes:
+            node._thread_id = tid
+            for pub in node._publishers:
+                pub._thread_id = tid
+
+    def _request_shutdown(self) -> None:
+        self._ok = False
+        self._shutdown_from_callback = self.in_callback()
+        callbacks, self._on_shutdown = self._on_shutdown, []
+        for cb in callbacks:
+            try:
+                cb()
+            except Exception:  # pragma: no cover - a user hook
+                import logging
+
+                logging.getLogger("rclpy").error("on_shutdown callback %r raised", cb, exc_info=True)
+        self.wake()
+        runtime = self.runtime
+        if runtime is not None:
+            runtime.shutdown()
+
+    def _close_if_idle(self) -> None:
+        """Close the runtime and the loop once no thread runs the loop."""
+        with self._lock:
+            loop, runtime = self.loop, self.runtime
+            if self._ok or self._closed or loop is None or runtime is None:
+                return
+            if loop.is_running() or self._spin_lock.locked():
+                return  # the spinning thread closes it on its way out
+            self._closed = True
+            self._restore_signal_handlers()
+            try:
+                loop.run_until_complete(runtime.__aexit__(None, None, None))
+                loop.run_until_complete(loop.shutdown_asyncgens())
+            finally:
+                loop.close()
+                self.loop = None
+                self.runtime = None
+
+    def _install_signal_handlers(self) -> None:
+        if threading.current_thread() is not threading.main_thread():
+            return
+
+        def on_sigint(signum: int, frame: Any) -> None:
+            self._ok = False
+            self._shutdown_from_callback = False
+            loop, runtime = self.loop, self.runtime
+            if loop is not None and runtime is not None and not loop.is_closed():
+                loop.call_soon_threadsafe(runtime.shutdown)
+            raise KeyboardInterrupt
+
+        def on_sigterm(signum: int, frame: Any) -> None:
+            self._ok = False
+            self._shutdown_from_callback = False
+            loop = self.loop
+            if loop is not None and not loop.is_closed():
+                loop.call_soon_threadsafe(self.wake)
+                if self.runtime is not None:
+                    loop.call_soon_threadsafe(self.runtime.shutdown)
+
+        for sig, handler in ((signal.SIGINT, on_sigint), (signal.SIGTERM, on_sigterm)):
+            try:
+                self._saved_handlers[sig] = signal.signal(sig, handler)
+            except (ValueError, OSError):  # pragma: no cover
+                pass
+
+    def _restore_signal_handlers(self) -> None:
+        if threading.current_thread() is not threading.main_thread():
+            return
+        for sig, previous in self._saved_handlers.items():
+            signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
+        self._saved_handlers.clear()
+
+
+def _build_node(spec: str) -> Any:
+    import importlib
+
+    module_name, sep, attr = spec.partition(":")
+    if not sep or not module_name or not attr:
+        raise ValueError(f"--node: expected module:Class, found {spec!r}")
+    factory = getattr(importlib.import_module(module_name), attr)
+    return factory()
+
+
+def _resolve(waiter: asyncio.Future[None]) -> None:
+    if not waiter.done():
+        waiter.set_result(None)
+
+
+_default: Context | None = None
+
+
+def default_context() -> Context:
+    global _default
+    if _default is None:
+        _default = Context()
+    return _default

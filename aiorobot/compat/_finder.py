@@ -1,0 +1,142 @@
+"""The import aliases: ``rclpy``, message packages, ``tf2_ros``, ``message_filters`` -> aiorobot.
+
+A meta path finder placed first on ``sys.meta_path``: ``rclpy[.x]`` resolves to
+``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters`` to
+their aiorobot modules, and ``<pkg>.msg|srv|action`` to module views of
+``aiorobot.msgs`` for every package aiorobot has interfaces of.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.abc
+import importlib.machinery
+import sys
+import types
+from typing import Any
+
+from ._missing import not_provided
+
+__all__ = ["AliasFinder", "install", "uninstall"]
+
+_ALIASES = {
+    "rclpy": "aiorobot.compat.rclpy",
+    "tf2_ros": "aiorobot.compat.tf2_ros",
+    "tf2_geometry_msgs": "aiorobot.compat.tf2_geometry_msgs",
+    "message_filters": "aiorobot.message_filters",
+}
+#: rclpy modules aiorobot lacks: importing one names it.
+_MISSING_MODULES = frozenset(
+    {
+        "rclpy.guard_condition", "rclpy.waitable", "rclpy.wait_for_message", "rclpy.event_handler",
+        "rclpy.qos_event", "rclpy.qos_overriding_options", "rclpy.serialization", "rclpy.type_support",
+        "rclpy.impl", "rclpy.topic_endpoint_info", "rclpy.service_introspection", "rclpy.parameter_service",
+        "rclpy.parameter_client", "rclpy.expand_topic_name", "rclpy.validate_topic_name",
+        "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
+        "rclpy.time_source", "rclpy.experimental", "rclpy.lifecycle",
+    }
+)
+
+
+def _msg_packages() -> frozenset[str]:
+    from ..msgs._registry import all_names
+
+    return frozenset(name.split("/", 1)[0] for name in all_names())
+
+
+class _Existing(importlib.abc.Loader):
+    """Loads an alias: hands back the already imported target module, its own spec kept."""
+
+    def __init__(self, module: types.ModuleType) -> None:
+        self.module = module
+        self.spec = getattr(module, "__spec__", None)
+
+    def create_module(self, spec: importlib.machinery.ModuleSpec) -> types.ModuleType:
+        return self.module
+
+    def exec_module(self, module: types.ModuleType) -> None:
+        if self.spec is not None:
+            module.__spec__ = self.spec
+
+
+def _interface_module(package: str, kind: str) -> types.ModuleType:
+    from ..msgs._registry import exists, get, package_names
+
+    fullname = f"{package}.{kind}"
+    module = types.ModuleType(fullname, f"ROS 2 {kind} types of {package}, from aiorobot.msgs")
+    names = sorted(n for n in package_names(package) if exists(f"{package}/{kind}/{n}"))
+    module.__all__ = names  # type: ignore[attr-defined]
+
+    def __getattr__(name: str) -> Any:
+        if name in names:
+            cls = get(f"{package}/{kind}/{name}")
+            setattr(module, name, cls)
+            return cls
+        if name.startswith("_"):
+            raise AttributeError(f"module {fullname!r} has no attribute {name!r}")
+        raise ImportError(
+            f"aiorobot does not provide {fullname}.{name} ({package}/{kind}/{name} is not among its "
+            f"interface types; register it with aiorobot.msgs.register_file)"
+        )
+
+    module.__getattr__ = __getattr__  # type: ignore[attr-defined]
+    return module
+
+
+class AliasFinder(importlib.abc.MetaPathFinder):
+    def __init__(self) -> None:
+        self._packages: frozenset[str] | None = None
+
+    def packages(self) -> frozenset[str]:
+        if self._packages is None:
+            self._packages = _msg_packages()
+        return self._packages
+
+    def find_spec(self, fullname: str, path: Any = None, target: Any = None) -> importlib.machinery.ModuleSpec | None:
+        top, _, rest = fullname.partition(".")
+        if top in _ALIASES:
+            if fullname in _MISSING_MODULES or any(fullname.startswith(m + ".") for m in _MISSING_MODULES):
+                raise not_provided(fullname)
+            target_name = _ALIASES[top] + ("." + rest if rest else "")
+            try:
+                module = importlib.import_module(target_name)
+            except ModuleNotFoundError as err:
+                if err.name == target_name:
+                    raise not_provided(fullname) from None
+                raise
+            return importlib.util.spec_from_loader(fullname, _Existing(module), is_package=hasattr(module, "__path__"))
+        if top in self.packages():
+            if not rest:
+                module = types.ModuleType(top, f"ROS 2 package {top}, from aiorobot.msgs")
+                module.__path__ = []  # type: ignore[attr-defined]
+                return importlib.util.spec_from_loader(fullname, _Existing(module), is_package=True)
+            if rest in ("msg", "srv", "action"):
+                return importlib.util.spec_from_loader(fullname, _Existing(_interface_module(top, rest)))
+        return None
+
+
+_finder: AliasFinder | None = None
+
+
+def install() -> AliasFinder:
+    """Put the aliases first on ``sys.meta_path`` (idempotent)."""
+    global _finder
+    import importlib.util  # noqa: F401  (used by find_spec)
+
+    if _finder is None:
+        _finder = AliasFinder()
+        _finder.packages()  # before the finder is in place: computing it imports modules
+    if _finder not in sys.meta_path:
+        sys.meta_path.insert(0, _finder)
+    return _finder
+
+
+def uninstall() -> None:
+    """Remove the aliases and forget the modules imported through them."""
+    global _finder
+    if _finder is not None and _finder in sys.meta_path:
+        sys.meta_path.remove(_finder)
+    packages = _finder.packages() if _finder is not None else frozenset()
+    for name in list(sys.modules):
+        if name.partition(".")[0] in _ALIASES or name.partition(".")[0] in packages:
+            del sys.modules[name]

@@ -1,0 +1,239 @@
+"""rclpy's ``Node`` on aiorobot's: rclpy's signatures, blocking calls, callbacks through the executor."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from .. import _actions, _services
+from .._node import Node as _AioNode
+from .._qos import QoSProfile
+from .._timer import Rate as _AioRate
+from ._context import Context, default_context
+from ._dispatch import wrap_callback
+from ._missing import not_provided
+
+__all__ = ["Client", "NodeMixin", "Rate", "make_node_class"]
+
+#: Node methods of rclpy that aiorobot lacks: using one raises NotProvidedError.
+MISSING_NODE_METHODS = frozenset(
+    {
+        "create_guard_condition",
+        "destroy_guard_condition",
+        "add_waitable",
+        "remove_waitable",
+        "waitables",
+        "guards",
+        "handle",
+        "get_publishers_info_by_topic",
+        "get_subscriptions_info_by_topic",
+        "get_clients_info_by_service",
+        "get_servers_info_by_service",
+        "enable_logger_service",
+    }
+)
+
+
+class Client(_services.Client):
+    """rclpy's ``Client``: ``wait_for_service`` and ``call`` block; ``call_async`` waits for the server."""
+
+    _context: Context
+
+    def wait_for_service(self, timeout_sec: float | None = None) -> bool:  # type: ignore[override]
+        ctx = self._context
+        if ctx.in_callback() and ctx.loop is not None and ctx.loop.is_running():
+            deadline = None if timeout_sec is None else time.monotonic() + timeout_sec
+            while not self.service_is_ready():
+                if deadline is not None and time.monotonic() >= deadline:
+                    return False
+                time.sleep(0.01)
+            return True
+        return ctx.run_sync(_services.Client.wait_for_service(self, timeout_sec), "Client.wait_for_service")
+
+    async def _call_when_ready(self, request: Any) -> Any:
+        await _services.Client.wait_for_service(self, None)
+        return await _services.Client.call(self, request)
+
+    def call_async(self, request: Any) -> Any:
+        from .._future import future_of
+
+        self._check_request(request)
+        ctx = self._context
+        fut = future_of(self._call_when_ready(request), None if _services._in_loop() else self.node._loop)
+        fut.add_done_callback(lambda _f: ctx.callback_finished())
+        return fut
+
+    def call(self, request: Any, timeout_sec: float | None = None) -> Any:  # type: ignore[override]
+        """Send ``request`` and block until the response (``TimeoutError`` after ``timeout_sec``)."""
+        self._check_request(request)
+        return self._context.run_sync(_services.Client.call(self, request, timeout_sec), "Client.call")
+
+
+class Rate:
+    """rclpy's ``Rate``: ``sleep()`` blocks the calling thread until the next period (absolute grid)."""
+
+    def __init__(self, frequency: float) -> None:
+        if isinstance(frequency, bool) or not isinstance(frequency, (int, float)) or frequency <= 0:
+            raise ValueError(f"Rate: expected a frequency in Hz > 0, found {frequency!r}")
+        self._period = 1.0 / frequency
+        self._next = time.monotonic() + self._period
+        self._destroyed = False
+
+    def sleep(self) -> None:
+        if self._destroyed:
+            raise RuntimeError("Rate.sleep: the rate was destroyed")
+        now = time.monotonic()
+        if now >= self._next + self._period:
+            self._next = now + self._period
+        delay = self._next - now
+        self._next += self._period
+        if delay > 0:
+            time.sleep(delay)
+
+    def destroy(self) -> None:
+        self._destroyed = True
+
+
+class NodeMixin:
+    """What turns an aiorobot node class into rclpy's: put it first among the bases."""
+
+    _context: Context
+
+    def _compat_init(
+        self,
+        node_name: str,
+        context: Context | None,
+        cli_args: Sequence[str] | None,
+        namespace: str | None,
+        use_global_arguments: bool,
+        kwargs: dict[str, Any],
+        base_init: Callable[..., None],
+    ) -> None:
+        ctx = context or default_context()
+        ctx.require_ok(f"Node({node_name!r})")
+        args = list(ctx.argv if use_global_arguments else []) + list(cli_args or [])
+        self._context = ctx
+        self._executor_ref = None
+        base_init(self, node_name, namespace=namespace or "", cli_args=args, **kwargs)
+        assert ctx.runtime is not None
+        ctx.runtime.add_node(self)  # type: ignore[arg-type]
+
+    @property
+    def context(self) -> Context:
+        return self._context
+
+    @property
+    def default_callback_group(self) -> Any:
+        return self._default_group  # type: ignore[attr-defined]
+
+    @property
+    def clients(self) -> tuple[Any, ...]:
+        return tuple(self._clients)  # type: ignore[attr-defined]
+
+    @property
+    def services(self) -> tuple[Any, ...]:
+        return tuple(self._services)  # type: ignore[attr-defined]
+
+    def _wrap(self, callback: Any) -> Any:
+        if getattr(self, "_compat_raw", 0):
+            return callback  # aiorobot's own entities (action internals, parameter services)
+        return wrap_callback(self._context, callback)
+
+    def create_publisher(  # type: ignore[override]
+        self, msg_type: Any, topic: str, qos_profile: QoSProfile | int, *, callback_group: Any = None,
+        event_callbacks: Any = None, qos_overriding_options: Any = None, publisher_class: Any = None,
+    ) -> Any:
+        return super().create_publisher(msg_type, topic, qos_profile)  # type: ignore[misc]
+
+    def create_subscription(  # type: ignore[override]
+        self, msg_type: Any, topic: str, callback: Callable[[Any], Any], qos_profile: QoSProfile | int, *,
+        callback_group: Any = None, event_callbacks: Any = None, qos_overriding_options: Any = None, raw: bool = False,
+    ) -> Any:
+        if raw:
+            raise not_provided("rclpy.node.Node.create_subscription(raw=True)")
+        return super().create_subscription(  # type: ignore[misc]
+            msg_type, topic, self._wrap(callback), qos_profile, callback_group=callback_group
+        )
+
+    def create_timer(  # type: ignore[override]
+        self, timer_period_sec: float, callback: Callable[..., Any], callback_group: Any = None,
+        clock: Any = None, autostart: bool = True,
+    ) -> Any:
+        return super().create_timer(  # type: ignore[misc]
+            timer_period_sec, self._wrap(callback), callback_group=callback_group, autostart=autostart
+        )
+
+    def create_rate(self, frequency: float, clock: Any = None) -> Rate:  # type: ignore[override]
+        return Rate(frequency)
+
+    def destroy_rate(self, rate: Any) -> None:  # type: ignore[override]
+        rate.destroy()
+
+    def create_service(  # type: ignore[override]
+        self, srv_type: Any, srv_name: str, callback: Callable[..., Any], *, qos_profile: Any = None,
+        callback_group: Any = None,
+    ) -> Any:
+        return super().create_service(  # type: ignore[misc]
+            srv_type, srv_name, self._wrap(callback), callback_group=callback_group
+        )
+
+    def create_client(  # type: ignore[override]
+        self, srv_type: Any, srv_name: str, *, qos_profile: Any = None, callback_group: Any = None
+    ) -> Any:
+        if getattr(self, "_compat_raw", 0):
+            return super().create_client(srv_type, srv_name, callback_group=callback_group)  # type: ignore[misc]
+        client = Client(
+            self, srv_type, self.resolve_topic_name(srv_name, kind="service"),  # type: ignore[attr-defined]
+            callback_group or self._default_group,  # type: ignore[attr-defined]
+        )
+        client._context = self._context
+        self._clients.append(client)  # type: ignore[attr-defined]
+        if self._runtime is not None:  # type: ignore[attr-defined]
+            self._runtime._bus.services.add(client)  # type: ignore[attr-defined]
+        return client
+
+    def __getattr__(self, name: str) -> Any:
+        if name in MISSING_NODE_METHODS:
+            raise not_provided(f"rclpy.node.Node.{name}")
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+
+def make_node_class(base: type, name: str, module: str, doc: str) -> type:
+    """rclpy's constructor signature over ``base`` (aiorobot's Node or LifecycleNode)."""
+
+    def __init__(
+        self: Any, node_name: str, *, context: Context | None = None, cli_args: Sequence[str] | None = None,
+        namespace: str | None = None, use_global_arguments: bool = True, enable_rosout: bool = True,
+        start_parameter_services: bool = True, parameter_overrides: Any = None,
+        allow_undeclared_parameters: bool = False, automatically_declare_parameters_from_overrides: bool = False,
+        enable_logger_service: bool = False, **extra: Any,
+    ) -> None:
+        kwargs = dict(
+            start_parameter_services=start_parameter_services, parameter_overrides=parameter_overrides,
+            allow_undeclared_parameters=allow_undeclared_parameters,
+            automatically_declare_parameters_from_overrides=automatically_declare_parameters_from_overrides,
+            **extra,
+        )
+        NodeMixin._compat_init(self, node_name, context, cli_args, namespace, use_global_arguments, kwargs, base.__init__)
+
+    cls = type(name, (NodeMixin, base), {"__init__": __init__, "__doc__": doc, "__module__": module})
+    return cls
+
+
+def raw(node: Any) -> Any:
+    """Context manager: entities created inside are aiorobot's own (callbacks not wrapped)."""
+    import contextlib
+
+    @contextlib.contextmanager
+    def scope() -> Any:
+        node._compat_raw = getattr(node, "_compat_raw", 0) + 1
+        try:
+            yield
+        finally:
+            node._compat_raw -= 1
+
+    return scope()
+
+
+_ = (_actions, _AioNode, _AioRate)

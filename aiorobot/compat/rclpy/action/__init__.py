@@ -1,0 +1,93 @@
+"""``rclpy.action``: action servers and clients with rclpy's signatures, on aiorobot's."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+from .... import _actions
+from ...._actions import CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
+from ..._missing import module_getattr
+from ..._node import raw
+
+__all__ = [
+    "ActionClient", "ActionServer", "CancelResponse", "ClientGoalHandle", "GoalResponse", "GoalStatus",
+    "ServerGoalHandle",
+]
+
+
+def _wrap(node: Any, callback: Any) -> Any:
+    wrap = getattr(node, "_wrap", None)
+    return callback if wrap is None or callback is None else wrap(callback)
+
+
+class ActionServer(_actions.ActionServer):
+    """rclpy's ``ActionServer(node, action_type, action_name, execute_callback, ...)``."""
+
+    def __init__(
+        self, node: Any, action_type: Any, action_name: str, execute_callback: Callable[[Any], Any], *,
+        callback_group: Any = None, goal_callback: Any = None, handle_accepted_callback: Any = None,
+        cancel_callback: Any = None, goal_service_qos_profile: Any = None, result_service_qos_profile: Any = None,
+        cancel_service_qos_profile: Any = None, feedback_pub_qos_profile: Any = None,
+        status_pub_qos_profile: Any = None, result_timeout: float = 900,
+    ) -> None:
+        with raw(node):
+            super().__init__(
+                node, action_type, action_name, _wrap(node, execute_callback),
+                goal_callback=_wrap(node, goal_callback),
+                handle_accepted_callback=_wrap(node, handle_accepted_callback),
+                cancel_callback=_wrap(node, cancel_callback),
+                callback_group=callback_group, result_timeout=result_timeout,
+            )
+
+    def register_execute_callback(self, execute_callback: Callable[[Any], Any]) -> None:
+        self._execute = _wrap(self.node, execute_callback)
+
+
+class ActionClient(_actions.ActionClient):
+    """rclpy's ``ActionClient(node, action_type, action_name)``: ``wait_for_server`` blocks."""
+
+    def __init__(self, node: Any, action_type: Any, action_name: str, *, callback_group: Any = None, **qos: Any) -> None:
+        with raw(node):
+            super().__init__(node, action_type, action_name, callback_group=callback_group)
+
+    def wait_for_server(self, timeout_sec: float | None = None) -> bool:  # type: ignore[override]
+        ctx = self.node._context
+        if ctx.in_callback() and ctx.loop is not None and ctx.loop.is_running():
+            deadline = None if timeout_sec is None else time.monotonic() + timeout_sec
+            while not self.server_is_ready():
+                if deadline is not None and time.monotonic() >= deadline:
+                    return False
+                time.sleep(0.01)
+            return True
+        return bool(ctx.run_sync(_actions.ActionClient.wait_for_server(self, timeout_sec), "ActionClient.wait_for_server"))
+
+    def send_goal_async(self, goal: Any, feedback_callback: Any = None, goal_uuid: Any = None) -> Any:
+        ctx = self.node._context
+        from ...._future import future_of
+
+        if not isinstance(goal, self.action_type.Goal):
+            raise TypeError(f"send_goal_async expects {self.action_type.Goal.__msgtype__}, got {type(goal).__name__}")
+        coro = _actions.ActionClient.send_goal(self, goal, _wrap(self.node, feedback_callback), goal_uuid=goal_uuid)
+        fut = future_of(coro, self._loop_for_futures())
+        fut.add_done_callback(lambda _f: ctx.callback_finished())
+        return fut
+
+    def send_goal(self, goal: Any, **kwargs: Any) -> Any:  # type: ignore[override]
+        """Block until the goal's result; the ``GetResult`` response (``.status``, ``.result``)."""
+
+        async def run() -> Any:
+            handle = await _actions.ActionClient.send_goal(self, goal, _wrap(self.node, kwargs.get("feedback_callback")))
+            if not handle.accepted:
+                return None
+            return await handle._result_response()
+
+        return self.node._context.run_sync(run(), "ActionClient.send_goal")
+
+
+_orig_get_result_async = ClientGoalHandle.get_result_async
+
+__getattr__ = module_getattr(__name__, "rclpy.action", {"get_action_client_names_and_types_by_node",
+                                                         "get_action_names_and_types",
+                                                         "get_action_server_names_and_types_by_node"})

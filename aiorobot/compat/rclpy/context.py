@@ -1,0 +1,5 @@
+"""``rclpy.context``."""
+
+from .._context import Context
+
+__all__ = ["Context"]

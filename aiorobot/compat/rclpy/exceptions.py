@@ -1,0 +1,25 @@
+"""``rclpy.exceptions``."""
+
+from ..._errors import (
+    InvalidParameterValueError as InvalidParameterValueException,
+    ParameterAlreadyDeclaredError as ParameterAlreadyDeclaredException,
+    ParameterImmutableError as ParameterImmutableException,
+    ParameterNotDeclaredError as ParameterNotDeclaredException,
+    ParameterUninitializedError as ParameterUninitializedException,
+    InvalidParameterTypeError as InvalidParameterTypeException,
+    InvalidNameError as InvalidNamespaceException,
+    InvalidNameError as InvalidNodeNameException,
+    InvalidNameError as InvalidTopicNameException,
+    InvalidNameError as InvalidServiceNameException,
+)
+
+__all__ = [
+    "InvalidNamespaceException", "InvalidNodeNameException", "InvalidParameterTypeException",
+    "InvalidParameterValueException", "InvalidServiceNameException", "InvalidTopicNameException",
+    "NotInitializedException", "ParameterAlreadyDeclaredException", "ParameterImmutableException",
+    "ParameterNotDeclaredException", "ParameterUninitializedException",
+]
+
+
+class NotInitializedException(Exception):
+    """rclpy.init() has not been called, or the context was shut down."""

@@ -1,0 +1,5 @@
+"""``rclpy.parameter``."""
+
+from ..._parameters import Parameter, ParameterType
+
+__all__ = ["Parameter", "ParameterType"]

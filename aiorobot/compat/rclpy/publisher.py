@@ -1,0 +1,5 @@
+"""``rclpy.publisher``."""
+
+from ..._pubsub import Publisher
+
+__all__ = ["Publisher"]

@@ -1,0 +1,5 @@
+"""``rclpy.service``."""
+
+from ..._services import Service
+
+__all__ = ["Service"]

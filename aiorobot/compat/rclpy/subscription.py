@@ -1,0 +1,5 @@
+"""``rclpy.subscription``."""
+
+from ..._pubsub import Subscription
+
+__all__ = ["Subscription"]

@@ -1,0 +1,7 @@
+"""``rclpy.task``: aiorobot's rclpy-style :class:`~aiorobot.Future` (thread-safe)."""
+
+from ..._future import Future
+
+__all__ = ["Future", "Task"]
+
+Task = Future

@@ -1,0 +1,5 @@
+"""``rclpy.time``."""
+
+from ..._time import Time
+
+__all__ = ["Time"]
