@@ -59,6 +59,8 @@ class Context:
         self._local = threading.local()
         self._on_shutdown: list[Callable[[], Any]] = []
         self._saved_handlers: dict[int, Any] = {}
+        #: Ctrl-C arrived while the loop ran in this thread: the spin raises KeyboardInterrupt on its way out
+        self._interrupted = False
         #: the executor whose spin is running the loop (decides where plain callbacks run)
         self.executor: Any = None
         self.callbacks_done = 0
@@ -193,6 +195,10 @@ class Context:
                 self._spin_thread = None
         finally:
             self._spin_lock.release()
+        if self._interrupted:
+            self._interrupted = False
+            self._close_if_idle()
+            raise KeyboardInterrupt
         if not self._ok:
             self._close_if_idle()
             if raise_on_shutdown and not shut_by_callback and not result:
@@ -301,6 +307,15 @@ class Context:
             loop, runtime = self.loop, self.runtime
             if loop is not None and runtime is not None and not loop.is_closed():
                 loop.call_soon_threadsafe(runtime.shutdown)
+                if (loop.is_running() and self._spin_thread == threading.get_ident()
+                        and not self._interrupted and not self.in_callback()):
+                    # The loop is between task steps or inside one of aiorobot's own: raising here would
+                    # leave the KeyboardInterrupt inside whichever task runs ("Task exception was never
+                    # retrieved"). Wake the spin instead; it raises KeyboardInterrupt from the spin call,
+                    # where rclpy raises it. A second Ctrl-C, or one inside a user callback, raises at once.
+                    self._interrupted = True
+                    loop.call_soon_threadsafe(self.wake)
+                    return
             raise KeyboardInterrupt
 
         def on_sigterm(signum: int, frame: Any) -> None:

@@ -91,13 +91,14 @@ class FrozenList(list):  # type: ignore[type-arg]
         return [copy.deepcopy(x, memo) for x in self]
 
 
-def _readonly_array(a: np.ndarray) -> np.ndarray:
+def _readonly_array(a: np.ndarray, dtype: np.dtype[Any] | None = None) -> np.ndarray:
     """What a subscriber gets for an array field: large ones shared, small ones copied; both read-only.
 
-    A list assigned to the field (rclpy code does ``msg.sequence = [0, 1]``) is copied into an array.
+    A list assigned to the field (rclpy code does ``msg.sequence = [0, 1]``) is copied into an array
+    of the field's ``dtype``.
     """
     if not isinstance(a, np.ndarray):
-        b = np.array(a)
+        b = np.array(a) if dtype is None else as_array(a, dtype)
         b.flags.writeable = False
         return b
     if not a.flags.writeable:
@@ -379,7 +380,8 @@ def _class_source(spec: MsgSpec, ns: dict[str, Any], get: Callable[[str], type])
         elif t.kind == SCALAR:
             freeze.append(f"    _S{i}(c, _T{i}._fz(m.{n}, F))")
         elif t.is_primitive:
-            freeze.append(f"    _S{i}(c, _ro(m.{n}))")
+            ns[f"_D{i}"] = _DTYPES[t.base]
+            freeze.append(f"    _S{i}(c, _ro(m.{n}, _D{i}))")
         elif t.is_string:
             freeze.append(f"    _S{i}(c, _FL(m.{n}))")
         else:

@@ -12,11 +12,6 @@ import pytest
 
 from ._run import Program
 
-_CTRL_C_RACE = pytest.mark.xfail(
-    reason="known weak: Ctrl-C landing inside a task step leaves 'Task exception was never retrieved' on stderr",
-    strict=False,
-)
-
 # (fixture, native nodes, lines expected (each at least `count` times), count, ends by itself)
 CASES = [
     ("examples_rclpy_minimal_publisher/publisher_member_function.py", ("Listener",),
@@ -28,7 +23,7 @@ CASES = [
     ("examples_rclpy_minimal_subscriber/subscriber_lambda.py", ("Talker",), ['I heard: "native'], 3, False),
     ("examples_rclpy_minimal_subscriber/subscriber_old_school.py", ("Talker",), ['I heard: "native'], 3, False),
     pytest.param("examples_rclpy_minimal_service/service.py", ("AddTwoIntsClient",),
-     ["Incoming request", "native client got: 5"], 1, False, marks=_CTRL_C_RACE),
+     ["Incoming request", "native client got: 5"], 1, False),
     ("examples_rclpy_minimal_service/service_member_function.py", ("AddTwoIntsClient",),
      ["Incoming request", "native client got: 5"], 1, False),
     ("examples_rclpy_minimal_client/client.py", ("AddTwoIntsServer",),
@@ -47,7 +42,7 @@ CASES = [
     ("examples_rclpy_executors/callback_group.py", (), ['I heard: "Hello World: 2"'], 1, False),
     ("demo_nodes_py/topics/talker.py", ("Listener",), ["Publishing: \"Hello World: 1\"", "native heard: Hello World: 1"], 1, False),
     ("demo_nodes_py/topics/listener.py", ("Talker",), ["I heard: [native"], 3, False),
-    pytest.param("demo_nodes_py/services/add_two_ints_server.py", ("AddTwoIntsClient",), ["native client got: 5"], 1, False, marks=_CTRL_C_RACE),
+    pytest.param("demo_nodes_py/services/add_two_ints_server.py", ("AddTwoIntsClient",), ["native client got: 5"], 1, False),
     ("demo_nodes_py/services/add_two_ints_client.py", ("AddTwoIntsServer",), ["Result of add_two_ints: 5"], 1, True),
     ("demo_nodes_py/services/add_two_ints_client_async.py", ("AddTwoIntsServer",), ["Result of add_two_ints: 5"], 1, True),
 ]

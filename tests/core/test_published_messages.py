@@ -182,3 +182,17 @@ async def test_fibonacci_feedback_reused_after_publish_feedback(runtime):
     assert list(result.sequence) == [0, 1, 1, 2, 3, 5]
     assert [list(m.feedback.sequence) for m in seen] == [[0, 1, 1], [0, 1, 1, 2], [0, 1, 1, 2, 3],
                                                         [0, 1, 1, 2, 3, 5]]
+
+
+async def test_a_list_assigned_to_an_array_field_arrives_as_a_read_only_array_of_the_fields_type(runtime):
+    # ros2/examples' Fibonacci server does `feedback.sequence = [0, 1]` then appends to it before publishing
+    from aiorobot.msgs.std_msgs import Int32MultiArray
+
+    pub, got = _pair(runtime, Int32MultiArray, "/numbers")
+    msg = Int32MultiArray()
+    msg.data = [0, 1]
+    msg.data.append(1)
+    pub.publish(msg)
+    await settle(runtime)
+    assert got[0].data.dtype == np.int32 and got[0].data.tolist() == [0, 1, 1]
+    assert not got[0].data.flags.writeable
