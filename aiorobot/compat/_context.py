@@ -307,12 +307,11 @@ class Context:
             loop, runtime = self.loop, self.runtime
             if loop is not None and runtime is not None and not loop.is_closed():
                 loop.call_soon_threadsafe(runtime.shutdown)
-                if (loop.is_running() and self._spin_thread == threading.get_ident()
-                        and not self._interrupted and not self.in_callback()):
-                    # The loop is between task steps or inside one of aiorobot's own: raising here would
-                    # leave the KeyboardInterrupt inside whichever task runs ("Task exception was never
-                    # retrieved"). Wake the spin instead; it raises KeyboardInterrupt from the spin call,
-                    # where rclpy raises it. A second Ctrl-C, or one inside a user callback, raises at once.
+                if loop.is_running() and self._spin_thread == threading.get_ident() and not self._interrupted:
+                    # Raising here would leave the KeyboardInterrupt inside whichever task step runs
+                    # ("Task exception was never retrieved"). Wake the spin instead: it raises
+                    # KeyboardInterrupt from the spin call, where rclpy raises it. A callback that blocks
+                    # the loop is interrupted by a second Ctrl-C, which raises at once.
                     self._interrupted = True
                     loop.call_soon_threadsafe(self.wake)
                     return
