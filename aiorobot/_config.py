@@ -31,9 +31,12 @@ __all__ = [
     "EXECUTORS",
     "FoxgloveConfig",
     "LOG_LEVELS",
+    "MAIN_PROCESS",
     "ConfigError",
     "GraphConfig",
     "NodeConfig",
+    "ProcessConfig",
+    "RESTART_POLICIES",
     "RecordConfig",
     "RuntimeConfig",
     "TRANSPORTS",
@@ -64,12 +67,20 @@ _RUNTIME_KEYS = (
     "stall_threshold",
     "priority_stall_threshold",
 )
-_NODE_KEYS = ("name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file", "on_failure")
+_NODE_KEYS = (
+    "name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file", "on_failure", "process"
+)
 #: what a node's failure to start does to the run (``[[nodes]] on_failure``)
 ON_FAILURE = ("stop", "continue", "restart")
 _RECORD_KEYS = ("path", "topics", "exclude", "compression", "max_bag_size", "max_bag_duration", "max_cache_size")
 _FOXGLOVE_KEYS = ("host", "port", "max_large_hz")
-_TOP_KEYS = ("runtime", "nodes", "record")
+_TOP_KEYS = ("runtime", "nodes", "record", "processes")
+#: ``[processes.<name>] restart``: when the supervisor starts a process again after it ended
+RESTART_POLICIES = ("no", "on-failure", "always")
+_PROCESS_KEYS = ("restart", "max_restarts", "restart_delay", "required")
+#: the process of ``aiorobot run`` itself (nodes without ``process`` run there)
+MAIN_PROCESS = "main"
+_PROCESS_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,62}$")
 
 _BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
 _USE = re.compile(
@@ -143,6 +154,7 @@ class NodeConfig:
     log_level: str | None = None
     parameters_file: str | None = None  # this node's ROS 2 YAML parameter file (absolute path)
     on_failure: str = "stop"
+    process: str = "main"  # the process running this node (``aiorobot run`` itself: "main")
 
     @property
     def key(self) -> str:
@@ -184,6 +196,25 @@ class FoxgloveConfig:
 
 
 @dataclass(frozen=True, slots=True)
+class ProcessConfig:
+    """One ``[processes.<name>]`` table: how ``aiorobot run`` supervises a child process.
+
+    ``restart``: ``"no"`` (never start it again), ``"on-failure"`` (the default: again after
+    a non-zero exit status or a death by a signal not sent by the supervisor) or
+    ``"always"`` (after a clean exit too), as systemd's ``Restart=``. At most
+    ``max_restarts`` restarts over the run; the n-th waits ``restart_delay * 2**(n-1)``
+    seconds (capped at 30 s). When a ``required`` process ends and is not restarted, the
+    whole graph shuts down (ROS launch's ``required``).
+    """
+
+    name: str
+    restart: str = "on-failure"
+    max_restarts: int = 5
+    restart_delay: float = 1.0
+    required: bool = False
+
+
+@dataclass(frozen=True, slots=True)
 class GraphConfig:
     """A validated configuration file."""
 
@@ -192,6 +223,12 @@ class GraphConfig:
     nodes: tuple[NodeConfig, ...]
     record: RecordConfig | None = None
     foxglove: FoxgloveConfig | None = None
+    processes: Mapping[str, ProcessConfig] = field(default_factory=lambda: MappingProxyType({}))
+
+    @property
+    def child_processes(self) -> tuple[str, ...]:
+        """The names of the processes other than ``main``, in the order of their first node."""
+        return tuple(dict.fromkeys(n.process for n in self.nodes if n.process != MAIN_PROCESS))
 
     @property
     def base_dir(self) -> Path:
@@ -231,24 +268,28 @@ def load_config(path: str | Path) -> GraphConfig:
     return parse_config(data, path)
 
 
-def build_nodes(config: GraphConfig) -> list[tuple[Any, str]]:
+def build_nodes(config: GraphConfig, process: str = MAIN_PROCESS) -> list[tuple[Any, str]]:
     """Import the node classes of ``config`` and construct the nodes: ``[(node, executor), ...]``.
 
     See :func:`aiorobot._config_build.build_nodes` (imported lazily: this module stays pure).
     """
     from ._config_build import build_nodes as _build_nodes
 
-    return _build_nodes(config)
+    return _build_nodes(config, process)
 
 
 def parse_config(data: Mapping[str, Any], path: str | Path = "<config>") -> GraphConfig:
     """Validate an already parsed TOML document (``tomllib.loads`` output)."""
     checker = _Checker(str(path))
     checker.check_keys(data, "", _TOP_KEYS)
-    runtime = _parse_runtime(checker, data.get("runtime", {}))
+    runtime_table = data.get("runtime", {})
+    raw_nodes = data.get("nodes")
+    multi_process = isinstance(raw_nodes, list) and any(
+        isinstance(t, dict) and t.get("process", MAIN_PROCESS) != MAIN_PROCESS for t in raw_nodes
+    )  # nodes in other processes meet over zenoh
+    runtime = _parse_runtime(checker, runtime_table, default_transport="zenoh" if multi_process else "local")
     nodes = _parse_nodes(checker, data)
     record = None
-    runtime_table = data.get("runtime", {})
     if "record" in data and "record" in runtime_table:
         raise checker.error("runtime.record", "the recording is set twice; keep either [record] or [runtime] record")
     if "record" in data:
@@ -256,13 +297,62 @@ def parse_config(data: Mapping[str, Any], path: str | Path = "<config>") -> Grap
     elif "record" in runtime_table:
         record = _parse_record(checker, runtime_table["record"], "runtime.record")
     foxglove = _parse_foxglove(checker, runtime_table["foxglove"]) if "foxglove" in runtime_table else None
-    return GraphConfig(path=str(path), runtime=runtime, nodes=nodes, record=record, foxglove=foxglove)
+    processes = _parse_processes(checker, data.get("processes", {}), nodes)
+    return GraphConfig(
+        path=str(path), runtime=runtime, nodes=nodes, record=record, foxglove=foxglove,
+        processes=MappingProxyType(processes),
+    )
 
 
-def _parse_runtime(checker: _Checker, table: Any) -> RuntimeConfig:
+def _parse_processes(checker: _Checker, table: Any, nodes: tuple[NodeConfig, ...]) -> dict[str, ProcessConfig]:
+    """One :class:`ProcessConfig` per child process named by a node (defaults where no table)."""
+    checker.check_type(table, "processes", dict, "a table of [processes.<name>] tables")
+    used = list(dict.fromkeys(n.process for n in nodes if n.process != MAIN_PROCESS))
+    for name in table:
+        key = checker.join("processes", name)
+        if name == MAIN_PROCESS:
+            raise checker.error(
+                key, 'expected the name of a child process, found "main" (aiorobot run itself, never restarted)'
+            )
+        if name not in used:
+            close = difflib.get_close_matches(name, used, n=1, cutoff=0.6)
+            hint = f' (did you mean "{close[0]}"?)' if close else ""
+            named = ", ".join(f'"{u}"' for u in used) or "none"
+            raise checker.error(
+                key, f'expected a process named by a [[nodes]] process key ({named}), found "{name}"{hint}'
+            )
+    processes = {}
+    for name in used:
+        sub = table.get(name, {})
+        key = checker.join("processes", name)
+        checker.check_type(sub, key, dict, 'a table such as { restart = "on-failure" }')
+        checker.check_keys(sub, key, _PROCESS_KEYS)
+        restart = checker.choice(sub, key, "restart", RESTART_POLICIES, "on-failure")
+        max_restarts = sub.get("max_restarts", 5)
+        checker.check_type(max_restarts, f"{key}.max_restarts", int, "an integer >= 0")
+        if max_restarts < 0:
+            raise checker.error(f"{key}.max_restarts", f"expected an integer >= 0, found {max_restarts}")
+        delay = sub.get("restart_delay", 1.0)
+        checker.check_type(delay, f"{key}.restart_delay", (int, float), "a number of seconds >= 0")
+        if not delay >= 0 or not math.isfinite(delay):
+            raise checker.error(f"{key}.restart_delay", f"expected a number of seconds >= 0, found {delay!r}")
+        required = sub.get("required", False)
+        checker.check_type(required, f"{key}.required", bool, "true or false")
+        processes[name] = ProcessConfig(name, restart, max_restarts, float(delay), required)
+    return processes
+
+
+def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "local") -> RuntimeConfig:
+    """``default_transport`` is "zenoh" when a node runs in another process (processes meet over zenoh)."""
     checker.check_type(table, "runtime", dict, "a table ([runtime])")
     checker.check_keys(table, "runtime", _RUNTIME_KEYS)
-    transport = checker.choice(table, "runtime", "transport", TRANSPORTS, "local")
+    transport = checker.choice(table, "runtime", "transport", TRANSPORTS, default_transport)
+    if default_transport == "zenoh" and transport != "zenoh":
+        raise checker.error(
+            "runtime.transport",
+            'a [[nodes]] process key puts a node in another process, which needs transport = "zenoh" '
+            f'(or no transport key), found "{transport}"',
+        )
     if transport not in _AVAILABLE_TRANSPORTS:
         raise checker.error(
             "runtime.transport",
@@ -382,6 +472,14 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
 
     log_level = checker.choice(table, key, "log_level", LOG_LEVELS, None)
     on_failure = checker.choice(table, key, "on_failure", ON_FAILURE, "stop")
+    process = table.get("process", MAIN_PROCESS)
+    checker.check_type(process, f"{key}.process", str, 'a process name such as "vision"')
+    if not _PROCESS_NAME.match(process):
+        raise checker.error(
+            f"{key}.process",
+            "expected a process name of letters, digits, '_' and '-' starting with a letter "
+            f"(at most 63 characters), found {_found(process)}",
+        )
     return NodeConfig(
         index=index,
         use=use,
@@ -393,6 +491,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
         log_level=log_level,
         parameters_file=_parameters_file(checker, table, key),
         on_failure=on_failure,
+        process=process,
     )
 
 

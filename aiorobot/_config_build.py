@@ -16,7 +16,7 @@ import sys
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from ._config import ConfigError, GraphConfig, NodeConfig
+from ._config import MAIN_PROCESS, ConfigError, GraphConfig, NodeConfig
 from ._errors import InvalidParameterValueError
 
 if TYPE_CHECKING:
@@ -25,16 +25,21 @@ if TYPE_CHECKING:
 __all__ = ["build_nodes", "import_node_class"]
 
 
-def build_nodes(config: GraphConfig) -> list[tuple[Node, str]]:
-    """Construct every node of ``config`` (nothing is started).
+def build_nodes(config: GraphConfig, process: str = MAIN_PROCESS) -> list[tuple[Node, str]]:
+    """Construct the nodes of ``config`` that run in ``process`` (nothing is started).
 
     The folder holding the config file is put on ``sys.path`` (first) so that
     ``use = "my_nodes:Talker"`` finds ``my_nodes.py`` beside the file.
 
+    For the main process (``aiorobot run`` itself) every node of the file is constructed,
+    so that a problem in any process is reported before any process starts; the nodes
+    of the other processes are then dropped (their child processes construct their own).
+    The ``[record]`` recorder and the Foxglove bridge run in the main process.
+
     Returns
     -------
     list of (Node, str)
-        Each node with its executor name (``"main"`` or ``"priority"``), in file order.
+        Each node of ``process`` with its executor name (``"main"`` or ``"priority"``), in file order.
 
     Raises
     ------
@@ -44,11 +49,14 @@ def build_nodes(config: GraphConfig) -> list[tuple[Node, str]]:
     base_dir = str(config.base_dir)
     if base_dir not in sys.path:
         sys.path.insert(0, base_dir)
+    main = process == MAIN_PROCESS
     built: list[tuple[Node, str]] = []
-    if config.record is not None:  # first, so it taps every publisher before its first message
+    if config.record is not None and main:  # first, so it taps every publisher before its first message
         built.append((_recorder(config), "main"))
     owners: dict[str, int] = {}
     for node_config in config.nodes:
+        if not main and node_config.process != process:
+            continue
         node = _construct(config, node_config)
         fqn = node.get_fully_qualified_name()
         if fqn in owners:
@@ -59,8 +67,9 @@ def build_nodes(config: GraphConfig) -> list[tuple[Node, str]]:
                 f"already called that); set a different name or namespace",
             )
         owners[fqn] = node_config.index
-        built.append((node, node_config.executor))
-    if config.foxglove is not None:
+        if node_config.process == process:
+            built.append((node, node_config.executor))
+    if config.foxglove is not None and main:
         from aiorobot.foxglove import FoxgloveBridge
 
         fox = config.foxglove

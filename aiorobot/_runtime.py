@@ -109,6 +109,11 @@ class Runtime:
 
             cfg = load_config(os.fspath(config)) if isinstance(config, (str, os.PathLike)) else config
             self._config = cfg
+            if cfg.child_processes:
+                raise ValueError(
+                    f"{cfg.path}: its nodes run in several processes ({', '.join(cfg.child_processes)}); "
+                    "a Runtime is one process: start the file with aiorobot run"
+                )
             transport = cfg.runtime.transport
             if cfg.runtime.zenoh_config:
                 transport = make_transport("zenoh", domain_id=cfg.runtime.domain_id, config_file=cfg.runtime.zenoh_config)

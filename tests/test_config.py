@@ -223,7 +223,7 @@ def test_unknown_key_without_a_close_match_lists_the_allowed_keys(tmp_path: Path
     with pytest.raises(
         ConfigError,
         match=r"^.*: nodes\[0\]\.zzz: unknown key \(expected one of: name, use, executor, namespace, "
-        r"parameters, remap, log_level, parameters_file, on_failure\)$",
+        r"parameters, remap, log_level, parameters_file, on_failure, process\)$",
     ):
         load_config(path)
 

@@ -32,6 +32,8 @@ def main(args: argparse.Namespace) -> int:
         cfg.insert_json5("listen/endpoints", json.dumps(args.listen or ["tcp/127.0.0.1:7447"]))
     if not args.config:
         cfg.insert_json5("scouting/multicast/enabled", "false")
+        # as the sessions: what the router forwards (client-mode peers) is not held for batching
+        cfg.insert_json5("transport/link/tx/queue/batching/enabled", "false")
     try:
         session = zenoh.open(cfg)
     except Exception as err:

@@ -3,11 +3,16 @@
 Everything is loaded, imported, constructed and checked before the runtime starts, so a
 bad file starts no node. SIGINT and SIGTERM shut the runtime down cleanly.
 
+Nodes with ``process = "name"`` run in child processes that ``aiorobot run`` starts,
+restarts and stops (see :mod:`aiorobot.cli._supervisor`); ``--process NAME`` runs only
+the nodes of one process (what each child runs; ``main`` is the nodes without a process key).
+
 Exit status: 0 after a clean run; 1 when a node failed to start or any callback raised
 (listed per node and entity on stderr; ``--keep-going`` only keeps the other nodes
-running); 2 for a bad configuration; 124 when the shutdown did not finish within
-``runtime.shutdown_timeout`` or a second signal abandoned what was blocked; 130 when
-interrupted before the runtime started.
+running), or a child process failed (even if restarted); 2 for a bad configuration;
+124 when the shutdown did not finish within ``runtime.shutdown_timeout`` or a second
+signal abandoned what was blocked (in any process); 130 when interrupted before the
+runtime started.
 """
 
 from __future__ import annotations
@@ -73,6 +78,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "nodes that leave on_failure at \"stop\"); the exit status is still 1 when a node failed "
         "to start or a callback raised",
     )
+    parser.add_argument(
+        "--process",
+        metavar="NAME",
+        help="run only the nodes with process = NAME (\"main\": those without a process key), "
+        "without starting the other processes; each process of a multi-process file runs this way",
+    )
+    # set by the supervising `aiorobot run` on its children: its zenoh endpoint; stdin is its pipe
+    parser.add_argument("--supervisor", metavar="ENDPOINT", help=argparse.SUPPRESS)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -103,6 +116,9 @@ def main(args: argparse.Namespace) -> int:
     except ConfigError as err:
         print(err, file=sys.stderr)
         return EXIT_CONFIG_ERROR
+    process = _process_of(args, config)
+    if process is None:
+        return EXIT_CONFIG_ERROR
 
     import aiorobot
 
@@ -113,8 +129,11 @@ def main(args: argparse.Namespace) -> int:
         from aiorobot._config_build import build_nodes
 
         # Constructors run here, outside the event loop: a Ctrl-C interrupts one that blocks.
-        nodes = build_nodes(config)  # raises ConfigError before anything starts
-        return aiorobot.run(_serve(config, nodes, args.duration, args.status_period, args.keep_going))
+        nodes = build_nodes(config, process)  # raises ConfigError before anything starts
+        return aiorobot.run(
+            _serve(config, nodes, args.duration, args.status_period, args.keep_going, process=process,
+                   supervisor=getattr(args, "supervisor", None), supervise=args.process is None)
+        )
     except ConfigError as err:
         print(err, file=sys.stderr)
         return EXIT_CONFIG_ERROR
@@ -123,12 +142,49 @@ def main(args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
 
 
+def _process_of(args: argparse.Namespace, config: GraphConfig) -> str | None:
+    """The process this invocation runs (``--process``, default ``main``); None after printing an error."""
+    from aiorobot._config import MAIN_PROCESS
+
+    process = getattr(args, "process", None) or MAIN_PROCESS
+    known = (MAIN_PROCESS, *config.child_processes)
+    if process not in known:
+        names = ", ".join(f'"{p}"' for p in known)
+        print(f"{config.path}: --process: expected one of {names}, found \"{process}\"", file=sys.stderr)
+        return None
+    return process
+
+
 async def _serve(
     config: GraphConfig,
     nodes: list[tuple[Node, str]],
     duration_sec: float | None,
     status_period_sec: float,
     keep_going: bool = False,
+    *,
+    process: str = "main",
+    supervisor: str | None = None,
+    supervise: bool = True,
+) -> int:
+    """Run ``process``'s nodes; the main process of a multi-process file also runs the others
+    (``supervise``), a child started by one connects to its endpoint (``supervisor``)."""
+    from ._supervisor import ProcessGroup
+
+    group = ProcessGroup(config, process, supervisor=supervisor, supervise=supervise, status_period_sec=status_period_sec)
+    try:
+        status = await _serve_process(config, nodes, duration_sec, status_period_sec, keep_going, group)
+    finally:
+        await group.stop()
+    return group.outcome(status)
+
+
+async def _serve_process(
+    config: GraphConfig,
+    nodes: list[tuple[Node, str]],
+    duration_sec: float | None,
+    status_period_sec: float,
+    keep_going: bool,
+    group: Any,
 ) -> int:
     from aiorobot import Runtime
     from aiorobot._config import ConfigError
@@ -142,6 +198,8 @@ async def _serve(
     transport: Any = runtime_config.transport
     if runtime_config.zenoh_config:
         transport = make_transport("zenoh", domain_id=runtime_config.domain_id, config_file=runtime_config.zenoh_config)
+    elif group.endpoints:  # a multi-process graph: the processes meet at the supervisor's endpoint
+        transport = make_transport("zenoh", domain_id=runtime_config.domain_id, **group.endpoints)
     async with Runtime(
         transport=transport,
         domain_id=runtime_config.domain_id,
@@ -165,11 +223,13 @@ async def _serve(
                     f"runtime.strict_qos is set and {problem}",
                 )
         rt.add_nodes(nodes)
+        await group.start(rt)
         display = StatusDisplay(
             [node for node, _ in nodes], period_sec=status_period_sec, on_stream_closed=rt.shutdown
         )
         async with display:
             await rt.spin(duration_sec=duration_sec)
+        group.terminate()  # the children shut down while this process does
     return _outcome(rt)
 
 
