@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-__all__ = ["add_arguments", "main"]
+__all__ = ["add_arguments", "main", "run_as_default"]
 
 
 def _rtf(text: str) -> float:
@@ -45,6 +45,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="record the run's topics (raw camera frames excluded) into a rosbag2 directory with MCAP storage")
     parser.add_argument("--json", type=Path, metavar="FILE", help="write the summary's figures as JSON")
     parser.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the map with true, estimated and planned paths")
+
+
+def run_as_default(duration_sec: float | None = None) -> int:
+    """``aiorobot run`` without a file: the demo with its defaults (``duration_sec`` limits sim time)."""
+    parser = argparse.ArgumentParser(prog="aiorobot demo")
+    add_arguments(parser)
+    return main(parser.parse_args([] if duration_sec is None else ["--timeout", repr(float(duration_sec))]))
 
 
 def main(args: argparse.Namespace) -> int:

@@ -49,3 +49,11 @@ def test_cli_writes_the_summary_json_and_a_plot(tmp_path: Path) -> None:
         assert key in figures
     assert figures["waypoints_reached"] == figures["waypoints_total"] == 1
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_aiorobot_run_without_a_file_runs_the_demo(capsys: pytest.CaptureFixture[str]) -> None:
+    # two sim seconds of the warehouse mission: the demo runs, gives up, says so and exits 1
+    assert main(["run", "--duration", "2"]) == 1
+    out = capsys.readouterr()
+    assert "aiorobot demo: warehouse, 7 waypoints" in out.err
+    assert "aiorobot demo — warehouse" in out.out and "0 / 7" in out.out
