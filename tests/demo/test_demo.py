@@ -37,6 +37,12 @@ def test_cli_refuses_a_waypoint_in_a_wall_before_starting(capsys: pytest.Capture
     assert err.count("\n") == 1 and "waypoint 1 (3, 0) is outside the map or inside an obstacle of box" in err
     assert main(["demo", "--world", "nowhere"]) == 2
     assert "nowhere" in capsys.readouterr().err
+    # the pty runs on the wall clock: no serial drive in lock-step
+    assert main(["demo", "--world", "box", "--drive", "serial", "--rtf", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--drive serial needs --rtf > 0" in err
+    assert main(["demo", "--localisation", "landmarks", "--no-perception"]) == 2
+    assert "needs perception" in capsys.readouterr().err
 
 
 def test_cli_writes_the_summary_json_a_plot_and_a_bag_that_rosbags_reads(tmp_path: Path) -> None:
@@ -75,3 +81,11 @@ def test_aiorobot_run_without_a_file_runs_the_demo(capsys: pytest.CaptureFixture
     out = capsys.readouterr()
     assert "aiorobot demo: warehouse, 7 waypoints" in out.err
     assert "aiorobot demo — warehouse" in out.out and "0 / 7" in out.out
+
+
+async def test_landmark_localisation_reaches_the_waypoints_on_aruco_fixes() -> None:
+    summary = await run_demo("box", [(1.0, 0.0, math.pi / 2), (1.0, 1.0, math.pi)], seed=4, timeout_sim_sec=90.0,
+                             localisation="landmarks")
+    assert summary.succeeded, summary.figures()
+    assert summary.landmark_fixes > 20 and summary.perception_frames > 0
+    assert summary.localisation_rmse_m < 0.2  # map -> odom from the map-frame EKF on the fixes, against ground truth
