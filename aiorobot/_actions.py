@@ -250,6 +250,8 @@ class ActionServer:
             node.create_service(CancelGoal, base + "cancel_goal", self._on_cancel_goal, callback_group=internal),
             node.create_service(action_type.GetResult, base + "get_result", self._on_get_result, callback_group=internal),
         ]
+        # get_result waits for the goal to finish: the goal's own work is what keeps the node busy
+        self._services[2].waits_on_others = True
         self._feedback_pub = node.create_publisher(action_type.FeedbackMessage, base + "feedback", FEEDBACK_QOS)
         self._status_pub = node.create_publisher(GoalStatusArray, base + "status", STATUS_QOS)
         self._status_array = GoalStatusArray

@@ -127,12 +127,15 @@ class Service(_ServiceEndpoint):
         self._busy = 0
         self.destroyed = False
         self.handled = 0
+        #: True for a service whose handler only waits for other work to finish (an action's
+        #: ``get_result``): a call in progress then does not count as work for ``settle()``.
+        self.waits_on_others = False
 
     def __repr__(self) -> str:
         return f"<Service {self.srv_name} {self.type_name} of {self.node_name} queued={len(self._queue)}>"
 
     def is_idle(self) -> bool:
-        return not self._queue and self._busy == 0
+        return not self._queue and (self._busy == 0 or self.waits_on_others)
 
     def _enqueue(self, call: _Call) -> None:
         """Queue a call (on the server node's loop)."""

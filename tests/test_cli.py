@@ -16,6 +16,8 @@ from aiorobot.cli import COMMANDS, main
 
 CONFIGS = Path(__file__).parent / "configs"
 BAD_CONFIGS = sorted((CONFIGS / "bad").glob("*.toml")) + sorted((CONFIGS / "build").glob("*.toml"))
+#: the small example graph (an IMU publisher and a monitor on the priority loop); ``aiorobot run`` alone runs the demo
+EXAMPLE_GRAPH = Path(__file__).resolve().parent.parent / "aiorobot" / "examples" / "default.toml"
 RUN_TIMEOUT_SEC = 120.0  # generous: a shared 2-core machine may stall for seconds
 SCRIPT = Path(sysconfig.get_path("scripts")) / "aiorobot"
 NOISE = ("Traceback", "Task was destroyed", "Warning", "never awaited", "Exception ignored")
@@ -156,7 +158,7 @@ def test_console_script_runs_the_cli() -> None:
 
 @pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
 def test_bundled_example_runs_for_duration_and_exits_0() -> None:
-    result = aiorobot("run", "--duration", "3")
+    result = aiorobot("run", str(EXAMPLE_GRAPH), "--duration", "3")
     assert result.returncode == 0, result.stderr
     assert_clean(result.stderr)
     lines = result.stdout.splitlines()
@@ -216,7 +218,7 @@ def test_user_module_is_loaded_from_the_config_folder(tmp_path: Path) -> None:
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_signal_stops_a_running_graph_cleanly(signum: signal.Signals) -> None:
     proc = subprocess.Popen(
-        [sys.executable, "-m", "aiorobot.cli", "run"],
+        [sys.executable, "-m", "aiorobot.cli", "run", str(EXAMPLE_GRAPH)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -319,7 +321,7 @@ def test_log_levels_from_config_apply_runtime_wide_and_per_node(tmp_path: Path) 
 @pytest.mark.timeout(RUN_TIMEOUT_SEC + 60)
 def test_closed_stdout_pipe_stops_the_run_quietly() -> None:
     proc = subprocess.Popen(
-        [sys.executable, "-m", "aiorobot.cli", "run"],
+        [sys.executable, "-m", "aiorobot.cli", "run", str(EXAMPLE_GRAPH)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -345,7 +347,7 @@ def test_on_a_terminal_the_status_is_a_live_display_and_exits_cleanly() -> None:
     leader, follower = os.openpty()
     env = _env() | {"COLUMNS": "200", "TERM": "xterm"}
     with subprocess.Popen(
-        [sys.executable, "-m", "aiorobot.cli", "run", "--duration", "2", "--status-period", "0.5"],
+        [sys.executable, "-m", "aiorobot.cli", "run", str(EXAMPLE_GRAPH), "--duration", "2", "--status-period", "0.5"],
         stdin=subprocess.DEVNULL,
         stdout=follower,
         stderr=follower,

@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-__all__ = ["add_arguments", "main"]
+__all__ = ["add_arguments", "main", "run_as_default"]
 
 
 def _rtf(text: str) -> float:
@@ -32,8 +32,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rtf", type=_rtf, default=0.0, help="real-time factor (default 0: as fast as the machine allows)")
     parser.add_argument("--seed", type=int, default=1, help="seed of every noise model (default 1)")
     parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC", help="give up after this much sim time (default 600)")
+    parser.add_argument("--drive", choices=("serial", "direct"), default=None,
+                        help="serial: the mecanum base through the simulated ESP32 firmware on a pty (SerialMotorBridge + "
+                        "MecanumController), which runs on the wall clock and so needs --rtf > 0; direct: the simulator "
+                        "follows /cmd_vel, which can run in lock-step (default: serial when --rtf > 0, else direct)")
+    parser.add_argument("--localisation", choices=("amcl", "landmarks"), default="amcl",
+                        help="amcl: the particle filter on the lidar (default); landmarks: ArUco fixes from the "
+                        "perception worker into the map-frame EKF")
+    parser.add_argument("--no-perception", dest="perception", action="store_false",
+                        help="leave out the camera, ArUco and lidar-obstacle perception (needs --localisation amcl)")
+    parser.add_argument("--record", type=Path, metavar="DIR",
+                        help="record the run's topics (raw camera frames excluded) into a rosbag2 directory with MCAP storage")
     parser.add_argument("--json", type=Path, metavar="FILE", help="write the summary's figures as JSON")
     parser.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the map with true, estimated and planned paths")
+
+
+def run_as_default(duration_sec: float | None = None) -> int:
+    """``aiorobot run`` without a file: the demo with its defaults (``duration_sec`` limits sim time)."""
+    parser = argparse.ArgumentParser(prog="aiorobot demo")
+    add_arguments(parser)
+    return main(parser.parse_args([] if duration_sec is None else ["--timeout", repr(float(duration_sec))]))
 
 
 def main(args: argparse.Namespace) -> int:
@@ -49,6 +67,14 @@ def main(args: argparse.Namespace) -> int:
         for i, (x, y, _) in enumerate(waypoints):
             if not world.is_free_disc(x, y, 0.22):
                 raise ValueError(f"waypoint {i + 1} ({x:g}, {y:g}) is outside the map or inside an obstacle of {world.name}")
+        drive = args.drive or ("serial" if args.rtf > 0 else "direct")
+        if drive == "serial" and args.rtf == 0:
+            raise ValueError("--drive serial needs --rtf > 0 (the simulated firmware's pty runs on the wall clock); "
+                             "use --rtf 1, or --drive direct")
+        if args.localisation == "landmarks" and not args.perception:
+            raise ValueError("--localisation landmarks needs perception (drop --no-perception)")
+        if args.record is not None and args.record.exists():
+            raise ValueError(f"--record {args.record}: exists already; choose another directory or remove it")
     except (WorldError, ValueError) as err:
         print(f"aiorobot demo: error: {err}", file=sys.stderr)
         return 2
@@ -61,10 +87,13 @@ def main(args: argparse.Namespace) -> int:
             sys.stderr.write(line + "\n")
         sys.stderr.flush()
 
-    print(f"aiorobot demo: {world.name}, {len(waypoints)} waypoints, mecanum robot, seed {args.seed}, "
+    print(f"aiorobot demo: {world.name}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
+          f"{args.localisation} localisation, seed {args.seed}, "
           f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'} (Ctrl-C stops)", file=sys.stderr)
     try:
-        summary = aiorobot.run(run_demo(args.world, waypoints, rtf=args.rtf, seed=args.seed,
+        summary = aiorobot.run(run_demo(args.world, waypoints, rtf=args.rtf, seed=args.seed, drive=drive,
+                                        localisation=args.localisation, perception=args.perception,
+                                        record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress))
     except KeyboardInterrupt:
         print("\naiorobot demo: interrupted", file=sys.stderr)
@@ -87,7 +116,8 @@ def _print_summary(s: object) -> None:
     from rich.table import Table
 
     f = s.figures()  # type: ignore[attr-defined]
-    table = Table(title=f"aiorobot demo — {f['world']}: {f['status']}", title_justify="left")
+    table = Table(title=f"aiorobot demo — {f['world']}, {f['drive']} drive, {f['localisation']}: {f['status']}",
+                  title_justify="left")
     table.add_column("figure")
     table.add_column("value", justify="right")
     rows = [
@@ -97,8 +127,22 @@ def _print_summary(s: object) -> None:
         ("path driven", f"{f['path_length_m']:.1f} m"),
         ("recoveries", str(f["recoveries"])),
         ("sim time / wall time", f"{f['sim_sec']:.1f} s / {f['wall_sec']:.1f} s ({f['real_time_factor']:.1f}x real time)"),
-        ("process CPU", f"{f['cpu_pct']:.0f} % of a core"),
+        ("control period p50 / p99 / max", _control_text(f)),
+        ("perception (ArUco worker)", "off" if f["perception_fps"] is None else
+         f"{f['perception_fps']:.1f} frames/s wall, {f['perception_frames']} frames, {f['perception_dropped']} dropped"),
+        ("CPU: main process / perception workers", f"{f['cpu_pct']:.0f} % / {f['workers_cpu_pct']:.0f} % of a core"),
     ]
+    if f["localisation"] == "landmarks":
+        rows.insert(3, ("landmark fixes", str(f["landmark_fixes"])))
+    if f["record"]:
+        rows.append(("recorded to", f["record"]))
     for name, value in rows:
         table.add_row(name, value)
     Console(width=100).print(table)
+
+
+def _control_text(f: dict) -> str:
+    if f["control_period_p99_ms"] is None:
+        return "n/a at --rtf 0 (lock-step); run with --rtf 1"
+    return (f"{f['control_period_p50_ms']:.2f} / {f['control_period_p99_ms']:.2f} / {f['control_period_max_ms']:.2f} ms "
+            f"(nominal {f['control_period_nominal_ms']:.0f} ms, {f['control_loop'].split(' on ')[0]})")

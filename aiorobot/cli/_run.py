@@ -43,15 +43,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "Run a graph of nodes described by a TOML file: a [runtime] table and one [[nodes]] "
         "table per node (use = \"module:Class\"; the file's folder is importable). "
-        "Without a file, run the bundled example: an IMU publisher on the main loop and a "
-        "rate/latency monitor on the priority loop. Ctrl-C stops cleanly."
+        "Without a file, run `aiorobot demo` (the simulated robot's waypoint mission; --duration "
+        "then limits its sim time); the small example graph is aiorobot/examples/default.toml. "
+        "Ctrl-C stops cleanly."
     )
     parser.add_argument(
         "config",
         nargs="?",
         type=Path,
         metavar="CONFIG.toml",
-        help="graph configuration file (default: the bundled example)",
+        help="graph configuration file (default: run the demo)",
     )
     parser.add_argument(
         "--duration",
@@ -98,12 +99,11 @@ def main(args: argparse.Namespace) -> int:
     if args.ros_args is not None:
         print("aiorobot run: error: --ros-args needs a module:Class, not a config file", file=sys.stderr)
         return EXIT_CONFIG_ERROR
-    if args.config is None:
-        from aiorobot.examples import DEFAULT_CONFIG
+    if args.config is None:  # no file: the demo (the small example graph is aiorobot/examples/default.toml)
+        from ._demo import run_as_default
 
-        config_path: Path = DEFAULT_CONFIG
-    else:
-        config_path = args.config
+        return run_as_default(args.duration)
+    config_path: Path = args.config
     if config_path.suffix == ".py":
         print(
             f"{config_path}: expected a TOML graph file (aiorobot run graph.toml), found a Python file; "

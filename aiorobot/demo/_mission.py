@@ -61,10 +61,24 @@ class DemoSummary:
     sim_sec: float = 0.0
     wall_sec: float = 0.0
     real_time_factor: float = 0.0
+    drive: str = "direct"
+    localisation: str = "amcl"
+    #: the priority loop's control timer whose periods are measured (wall clock x rtf; None in lock-step)
+    control_loop: str = ""
+    control_period_nominal_ms: float | None = None
+    control_period_p50_ms: float | None = None
     control_period_p99_ms: float | None = None
     control_period_max_ms: float | None = None
+    control_periods: int = 0
+    #: ArUco frames processed by the worker per wall second, over the whole run
     perception_fps: float | None = None
+    perception_frames: int = 0
+    perception_dropped: int = 0
+    landmark_fixes: int = 0
+    #: CPU of the main process (its loops and threads) and of the perception workers, % of one core
     cpu_pct: float = 0.0
+    workers_cpu_pct: float = 0.0
+    record: str | None = None
     status: str = "UNKNOWN"
     missed: list[int] = field(default_factory=list)
     truth: list[tuple[float, float]] = field(default_factory=list, repr=False)
@@ -126,11 +140,78 @@ class _Monitor:
         self.summary.truth.append(self.truth_xy)
         self.summary.estimate.append(est)
 
+    def distance_left(self, waypoints: list[tuple[float, float, float]], index: int) -> float:
+        """Along the latest plan to the current waypoint, then straight between the remaining ones."""
+        if self.truth_xy is None:
+            return float("nan")
+        x, y = self.truth_xy
+        plan = self.summary.plans[-1] if self.summary.plans else []
+        wx, wy = waypoints[index][:2]
+        if plan and math.hypot(plan[-1][0] - wx, plan[-1][1] - wy) < 0.3:
+            pts = np.asarray(plan)
+            near = int(np.argmin(np.hypot(pts[:, 0] - x, pts[:, 1] - y)))
+            rest = pts[near:]
+            left = math.hypot(rest[0][0] - x, rest[0][1] - y) + float(np.hypot(*np.diff(rest, axis=0).T).sum())
+        else:
+            left = math.hypot(wx - x, wy - y)
+        for (ax, ay, _), (bx, by, _) in zip(waypoints[index:], waypoints[index + 1:]):
+            left += math.hypot(bx - ax, by - ay)
+        return left
+
     def finish(self) -> None:
         if self.errors:
             e = np.asarray(self.errors)
             self.summary.localisation_rmse_m = float(np.sqrt(np.mean(e * e)))
             self.summary.localisation_max_m = float(e.max())
+
+
+class _PeriodProbe:
+    """Wall-clock start times of one timer's callbacks (on whichever loop the timer runs)."""
+
+    def __init__(self, timer: Any) -> None:
+        self.stamps: list[int] = []
+        self.period_sec = timer.timer_period_ns / 1e9
+        inner = timer.callback
+        stamps = self.stamps
+
+        def probed(*args: Any, **kwargs: Any) -> Any:
+            stamps.append(time.perf_counter_ns())
+            return inner(*args, **kwargs)
+
+        timer.callback = probed
+
+    def periods_ms(self, since: int = 0) -> np.ndarray:
+        return np.diff(np.asarray(self.stamps[since:], dtype=np.int64)) / 1e6
+
+
+def _children_cpu_sec() -> float:
+    """CPU seconds of this process's live descendants (the perception workers, a forkserver), from /proc."""
+    import os
+
+    tick = os.sysconf("SC_CLK_TCK")
+    parent: dict[str, str] = {}
+    cpu: dict[str, float] = {}
+    try:
+        pids = [d for d in os.listdir("/proc") if d.isdigit()]
+    except OSError:
+        return 0.0
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        parent[pid] = fields[1]
+        cpu[pid] = (int(fields[11]) + int(fields[12])) / tick  # utime + stime
+    me = str(os.getpid())
+    total = 0.0
+    for pid, seconds in cpu.items():
+        p, hops = parent.get(pid), 0
+        while p is not None and p != me and p != "0" and hops < 64:
+            p, hops = parent.get(p), hops + 1
+        if p == me:
+            total += seconds
+    return total
 
 
 async def run_demo(
@@ -141,39 +222,48 @@ async def run_demo(
     seed: int = 1,
     timeout_sim_sec: float = 600.0,
     progress: Callable[[str], None] | None = None,
+    drive: str | None = None,
+    localisation: str = "amcl",
+    perception: bool = True,
+    record: str | None = None,
 ) -> DemoSummary:
-    """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows."""
+    """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows.
+
+    ``drive`` is ``"serial"`` (the simulated ESP32 firmware on a pty; needs ``rtf > 0``) or
+    ``"direct"`` (the simulator follows /cmd_vel); None picks serial when ``rtf > 0``.
+    ``localisation`` is ``"amcl"`` or ``"landmarks"`` (ArUco fixes into the map-frame EKF).
+    ``record`` is a directory for a rosbag2/MCAP bag of the run's topics (raw images excluded).
+    """
     from aiorobot import Node, Runtime
-    from aiorobot.nav import AmclNode, NavigationServer, Navigator, TaskResult, pose_stamped
-    from aiorobot.sim import Simulator, World
+    from aiorobot.nav import Navigator, TaskResult, pose_stamped
+    from aiorobot.sim import World
+
+    from ._graph import build_graph
 
     loaded = World.load(world)
     if waypoints is None:
         if loaded.name not in MISSIONS:
             raise ValueError(f"world {world!r} has no shipped mission; give one with --waypoints 'x,y[,yaw];...'")
         waypoints = MISSIONS[loaded.name]
-    summary = DemoSummary(world=loaded.name, waypoints_total=len(waypoints), real_time_factor=rtf)
-    sx, sy, syaw = loaded.start
-    wall0, cpu0 = time.perf_counter(), time.process_time()
+    if drive is None:
+        drive = "serial" if rtf > 0 else "direct"
+    graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
+                        record=record)
+    summary = DemoSummary(world=loaded.name, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
+                          localisation=localisation)
+    wall0, cpu0, child0 = time.perf_counter(), time.process_time(), _children_cpu_sec()
+    probe = _PeriodProbe(graph.control_node.timers[0])
+    summary.control_loop = f"{graph.control_node.get_name()} {1.0 / probe.period_sec:g} Hz on the priority loop"
+    sim, server = graph.simulator, graph.server
     # The simulator compiles its Numba kernels when it starts: seconds on the main loop, on purpose.
     async with Runtime(use_sim_time=True, stall_threshold=10.0) as rt:
-        sim = rt.add_node(Simulator(parameter_overrides={
-            "world": world, "robot": "mecanum", "seed": seed, "real_time_factor": rtf,
-            "publish_odom_tf": True, "camera_rate": 0.0,
-        }))
-        rt.add_node(AmclNode(parameter_overrides={
-            "robot_model_type": "omnidirectional", "set_initial_pose": True,
-            "initial_pose.x": sx, "initial_pose.y": sy, "initial_pose.yaw": syaw,
-            "update_min_d": 0.1, "update_min_a": 0.1, "min_particles": 300, "max_particles": 1000, "seed": seed,
-            "alpha1": 0.05, "alpha2": 0.05, "alpha3": 0.05, "alpha4": 0.05, "alpha5": 0.05, "sigma_hit": 0.1,
-        }))
-        server = rt.add_node(NavigationServer(parameter_overrides={"desired_linear_vel": 0.5, "stop_on_failure": False,
-                                                                   "movement_time_allowance": 15.0}))
+        rt.add_nodes(graph.nodes)
         nav = rt.add_node(Navigator())
         monitor = _Monitor(rt.add_node(Node("demo_monitor")), summary)
         poses = [pose_stamped(x, y, yaw) for x, y, yaw in waypoints]
         started = asyncio.ensure_future(nav.follow_waypoints(poses))
-        last = 0.0
+        probe_from = len(probe.stamps)
+        last, last_frames, child_cpu = 0.0, 0, 0.0
         try:
             while not (started.done() and nav.is_task_complete()):
                 await asyncio.sleep(0.05)
@@ -181,17 +271,18 @@ async def run_demo(
                 if now > timeout_sim_sec:
                     await nav.cancel_task()
                     break
-                if progress is not None and time.perf_counter() - last > 0.5:
-                    last = time.perf_counter()
-                    fb = nav.get_feedback()
-                    err = monitor.errors[-1] if monitor.errors else float("nan")
-                    wp = int(fb.current_waypoint) + 1 if fb is not None else 0
-                    progress(f"sim {now:6.1f} s  waypoint {wp}/{len(waypoints)}  localisation error {err * 100:5.1f} cm  "
-                             f"recoveries {server.recoveries}  collisions {sim.body.collisions}")
+                if time.perf_counter() - last > 0.5:
+                    child_cpu = max(child_cpu, _children_cpu_sec() - child0)  # workers are gone after shutdown
+                    frames = graph.aruco.pipeline.statistics().processed if graph.aruco is not None else 0
+                    fps = (frames - last_frames) / max(time.perf_counter() - last, 1e-9) if last else float("nan")
+                    last, last_frames = time.perf_counter(), frames
+                    if progress is not None:
+                        progress(_progress_line(now, nav, monitor, waypoints, probe, rtf, fps, sim, server))
             if started.done() and not started.result():
                 summary.status = "REJECTED"
         finally:
             monitor.finish()
+            child_cpu = max(child_cpu, _children_cpu_sec() - child0)
             result = nav.result
             summary.missed = [int(m.index) for m in result.missed_waypoints] if result is not None else []
             status = nav.get_result()
@@ -201,7 +292,43 @@ async def run_demo(
             summary.collisions = sim.body.collisions
             summary.recoveries = server.recoveries
             summary.sim_sec = rt.now().nanoseconds / 1e9
+            wall = time.perf_counter() - wall0
+            if graph.aruco is not None:
+                stats = graph.aruco.pipeline.statistics()
+                summary.perception_fps = stats.processed / max(wall, 1e-9)
+                summary.perception_frames = stats.processed
+                summary.perception_dropped = stats.dropped_queue
+            if graph.landmark_fixes is not None:
+                summary.landmark_fixes = graph.landmark_fixes.fixes
+            periods = probe.periods_ms(probe_from)
+            if rtf > 0 and periods.size:
+                # sim-time periods: the wall period scaled by the real-time factor
+                sim_periods = periods * rtf
+                summary.control_period_nominal_ms = probe.period_sec * 1e3
+                summary.control_period_p50_ms = float(np.percentile(sim_periods, 50))
+                summary.control_period_p99_ms = float(np.percentile(sim_periods, 99))
+                summary.control_period_max_ms = float(sim_periods.max())
+                summary.control_periods = int(sim_periods.size)
     summary.wall_sec = time.perf_counter() - wall0
     summary.cpu_pct = 100.0 * (time.process_time() - cpu0) / max(summary.wall_sec, 1e-9)
+    summary.workers_cpu_pct = 100.0 * child_cpu / max(summary.wall_sec, 1e-9)
     summary.real_time_factor = summary.sim_sec / max(summary.wall_sec, 1e-9)
+    if graph.recorder is not None:
+        summary.record = graph.recorder.path
     return summary
+
+
+def _progress_line(now: float, nav: Any, monitor: _Monitor, waypoints: list[Any], probe: _PeriodProbe, rtf: float,
+                   fps: float, sim: Any, server: Any) -> str:
+    fb = nav.get_feedback()
+    err = monitor.errors[-1] if monitor.errors else float("nan")
+    wp = min(int(fb.current_waypoint) + 1, len(waypoints)) if fb is not None else 0
+    left = monitor.distance_left(waypoints, wp - 1) if wp else float("nan")
+    if rtf > 0:
+        recent = probe.periods_ms(max(len(probe.stamps) - 100, 0)) * rtf
+        jitter = f"{np.abs(recent - probe.period_sec * 1e3).max():4.1f} ms" if recent.size else "  -  "
+    else:
+        jitter = "n/a (lock-step)"
+    fps_text = f"{fps:4.1f}" if math.isfinite(fps) else "  - "
+    return (f"sim {now:6.1f} s  waypoint {wp}/{len(waypoints)}  {left:5.1f} m left  loc. error {err * 100:5.1f} cm  "
+            f"jitter {jitter}  perception {fps_text} fps  recoveries {server.recoveries}  collisions {sim.body.collisions}")

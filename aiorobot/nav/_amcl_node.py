@@ -60,8 +60,12 @@ class AmclNode(Node):
         self.filter: Amcl | None = None
         self.updates = 0
         self.create_subscription(OccupancyGrid, "/map", self._on_map, MAP_QOS)
+        from .._groups import MutuallyExclusiveCallbackGroup
+
+        # Its own group: a scan waiting for its transform must not hold up the tf listener's callbacks.
         self.create_subscription(LaserScan, scan_topic if scan_topic.startswith("/") else f"/{scan_topic}", self._on_scan,
-                                 QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=5))
+                                 QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=5),
+                                 callback_group=MutuallyExclusiveCallbackGroup())
         self.create_subscription(PoseWithCovarianceStamped, "/initialpose", self._on_initial_pose, 10)
         self.pose_pub = self.create_publisher(PoseWithCovarianceStamped, "amcl_pose",
                                               QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1))
@@ -85,7 +89,7 @@ class AmclNode(Node):
                                          cov_aa=max(float(cov[35]), 1e-4))
             self.get_logger().info(f"initial pose ({x:.2f}, {y:.2f}, {yaw:.2f})")
 
-    def _on_scan(self, scan: Any) -> None:
+    async def _on_scan(self, scan: Any) -> None:
         from aiorobot import Time
         from aiorobot.tf import TransformException
 
@@ -95,6 +99,10 @@ class AmclNode(Node):
         ranges = np.asarray(scan.ranges, dtype=np.float64)
         stamp = Time.from_msg(scan.header.stamp)
         try:
+            # As nav2_amcl's tf MessageFilter: a scan waits (up to transform_tolerance) for the
+            # odom -> base_link at its stamp, which an odometry filter may publish a moment later.
+            if not self.buffer.can_transform(self.odom_frame, self.base_frame, stamp):
+                await self.buffer.wait_for_transform(self.odom_frame, self.base_frame, stamp, timeout_sec=self.tolerance)
             odom = transform_to_xyyaw(self.buffer.lookup_transform(self.odom_frame, self.base_frame, stamp))
             laser = transform_to_xyyaw(self.buffer.lookup_transform(self.base_frame, scan.header.frame_id, Time()))
         except TransformException as err:

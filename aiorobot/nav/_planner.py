@@ -57,7 +57,9 @@ def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, 
         raise PlanError(f"no path from ({start_xy[0]:.2f}, {start_xy[1]:.2f}) to ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}): the goal is unreachable")
     if smooth and cells.shape[0] > 2:
         cells = shortcut(cost, cells)
-    xy = np.array([costmap.cell_to_world(r, c) for r, c in cells], dtype=np.float64).reshape(-1, 2)
+    # cell centres, as Costmap.cell_to_world, for the whole path at once
+    xy = np.column_stack([costmap.origin[0] + (cells[:, 1] + 0.5) * costmap.resolution,
+                          costmap.origin[1] + (cells[:, 0] + 0.5) * costmap.resolution]).astype(np.float64)
     xy[0] = start_xy
     xy[-1] = goal_xy
     xy = resample(xy, costmap.resolution)

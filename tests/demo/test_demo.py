@@ -37,15 +37,55 @@ def test_cli_refuses_a_waypoint_in_a_wall_before_starting(capsys: pytest.Capture
     assert err.count("\n") == 1 and "waypoint 1 (3, 0) is outside the map or inside an obstacle of box" in err
     assert main(["demo", "--world", "nowhere"]) == 2
     assert "nowhere" in capsys.readouterr().err
+    # the pty runs on the wall clock: no serial drive in lock-step
+    assert main(["demo", "--world", "box", "--drive", "serial", "--rtf", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--drive serial needs --rtf > 0" in err
+    assert main(["demo", "--localisation", "landmarks", "--no-perception"]) == 2
+    assert "needs perception" in capsys.readouterr().err
 
 
-def test_cli_writes_the_summary_json_and_a_plot(tmp_path: Path) -> None:
-    out, png = tmp_path / "summary.json", tmp_path / "demo.png"
-    status = main(["demo", "--world", "box", "--waypoints", "1.0,0,0", "--seed", "2", "--json", str(out), "--plot", str(png)])
+def test_cli_writes_the_summary_json_a_plot_and_a_bag_that_rosbags_reads(tmp_path: Path) -> None:
+    out, png, bag = tmp_path / "summary.json", tmp_path / "demo.png", tmp_path / "bag"
+    status = main(["demo", "--world", "box", "--waypoints", "1.0,0,0", "--seed", "2", "--json", str(out), "--plot", str(png),
+                   "--record", str(bag)])
     figures = json.loads(out.read_text())
     assert status == 0, figures
     for key in ("waypoints_reached", "waypoints_total", "collisions", "localisation_rmse_m", "control_period_p99_ms",
-                "control_period_max_ms", "perception_fps", "sim_sec", "wall_sec"):
+                "control_period_max_ms", "perception_fps", "sim_sec", "wall_sec", "cpu_pct", "workers_cpu_pct"):
         assert key in figures
     assert figures["waypoints_reached"] == figures["waypoints_total"] == 1
+    assert figures["drive"] == "direct" and figures["control_period_p99_ms"] is None  # lock-step: no wall-clock periods
+    assert figures["perception_frames"] > 0 and figures["perception_fps"] > 0
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the bag, read back by an independent reader
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    with AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as reader:
+        topics = {c.topic for c in reader.connections}
+        assert {"/scan", "/tf", "/imu/data", "/odom", "/cmd_vel", "/plan", "/ground_truth/odom",
+                "/local/odometry/filtered", "/detections/markers"} <= topics, topics
+        assert "/camera/image_raw" not in topics  # raw frames are left out on purpose
+        truth = [c for c in reader.connections if c.topic == "/ground_truth/odom"]
+        last = None
+        for conn, _, raw in reader.messages(connections=truth):
+            last = reader.deserialize(raw, conn.msgtype)
+    # the goal tolerance (0.25 m) holds for the estimate; the true pose is within it plus the localisation error
+    assert last is not None and math.hypot(last.pose.pose.position.x - 1.0, last.pose.pose.position.y) < 0.4
+
+
+def test_aiorobot_run_without_a_file_runs_the_demo(capsys: pytest.CaptureFixture[str]) -> None:
+    # two sim seconds of the warehouse mission: the demo runs, gives up, says so and exits 1
+    assert main(["run", "--duration", "2"]) == 1
+    out = capsys.readouterr()
+    assert "aiorobot demo: warehouse, 7 waypoints" in out.err
+    assert "aiorobot demo — warehouse" in out.out and "0 / 7" in out.out
+
+
+async def test_landmark_localisation_reaches_the_waypoints_on_aruco_fixes() -> None:
+    summary = await run_demo("box", [(1.0, 0.0, math.pi / 2), (1.0, 1.0, math.pi)], seed=4, timeout_sim_sec=90.0,
+                             localisation="landmarks")
+    assert summary.succeeded, summary.figures()
+    assert summary.landmark_fixes > 20 and summary.perception_frames > 0
+    assert summary.localisation_rmse_m < 0.2  # map -> odom from the map-frame EKF on the fixes, against ground truth

@@ -1,0 +1,186 @@
+"""Landmark fixes: the robot's pose in the map from one ArUco marker at a known place.
+
+:func:`base_pose_from_marker` is the pure core (4x4 transforms on numpy); :class:`LandmarkFixNode`
+turns perception's ``/detections/markers`` into ``/landmark_pose``
+(``geometry_msgs/PoseWithCovarianceStamped`` of ``base_link`` in ``map``, at the image's stamp),
+the absolute input of the fusion package's map-frame EKF (``pose0`` of robot_localization's
+dual-EKF set-up, see ``examples/fusion_ekf.toml``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .._node import Node
+
+__all__ = ["LandmarkFixNode", "base_pose_from_marker", "map_from_marker"]
+
+
+def map_from_marker(x: float, y: float, z: float, yaw: float) -> NDArray[np.float64]:
+    """The (4, 4) pose of a wall marker's ArUco frame in the map.
+
+    ArUco's marker frame has x to the right and y up as a viewer facing the marker sees it,
+    and z out of the marker towards the viewer; the marker's outward normal points along ``yaw``.
+    """
+    c, s = math.cos(yaw), math.sin(yaw)
+    pose = np.eye(4)
+    pose[:3, 0] = (-s, c, 0.0)   # right, seen from the front
+    pose[:3, 1] = (0.0, 0.0, 1.0)  # up
+    pose[:3, 2] = (c, s, 0.0)    # the outward normal
+    pose[:3, 3] = (x, y, z)
+    return pose
+
+
+def base_pose_from_marker(
+    map_from_marker_: NDArray[np.float64],
+    optical_from_marker: NDArray[np.float64],
+    base_from_optical: NDArray[np.float64],
+    yaw: float | None = None,
+) -> tuple[float, float, float]:
+    """``(x, y, yaw)`` of the base in the map, from one marker seen by the camera.
+
+    With ``yaw`` given (the filter's current heading), only the marker's position is used:
+    the base is placed so that the marker appears where it was seen, at that heading. A
+    small marker's position is accurate to centimetres, its orientation is not (solvePnP's
+    two-fold ambiguity flips it by tenths of a radian), so fixes take their heading from
+    the filter and correct position only.
+
+    Parameters
+    ----------
+    map_from_marker_ : (4, 4)
+        Where the marker is (:func:`map_from_marker`).
+    optical_from_marker : (4, 4)
+        The detected marker pose in the camera optical frame (ArUco's rvec/tvec).
+    base_from_optical : (4, 4)
+        The camera optical frame on the base (tf base_link -> camera_optical_frame).
+    yaw : float, optional
+        The base's heading in the map; when None it comes from the marker's orientation.
+    """
+    a = np.asarray(map_from_marker_, dtype=np.float64)
+    b = np.asarray(optical_from_marker, dtype=np.float64)
+    c = np.asarray(base_from_optical, dtype=np.float64)
+    for name, m in (("map_from_marker", a), ("optical_from_marker", b), ("base_from_optical", c)):
+        if m.shape != (4, 4):
+            raise ValueError(f"{name} must have shape (4, 4), got shape {m.shape}")
+    if yaw is not None:
+        marker_in_base = c @ b[:, 3]
+        cy, sy = math.cos(yaw), math.sin(yaw)
+        x = a[0, 3] - (cy * marker_in_base[0] - sy * marker_in_base[1])
+        y = a[1, 3] - (sy * marker_in_base[0] + cy * marker_in_base[1])
+        return float(x), float(y), float(yaw)
+    map_from_base = a @ np.linalg.inv(b) @ np.linalg.inv(c)
+    return float(map_from_base[0, 3]), float(map_from_base[1, 3]), math.atan2(map_from_base[1, 0], map_from_base[0, 0])
+
+
+class LandmarkFixNode(Node):
+    """``/detections/markers`` (aiorobot_msgs/MarkerDetectionArray) -> ``/landmark_pose``.
+
+    Parameters: ``world`` (built-in world name or map YAML whose ``landmarks`` say where each
+    marker id is), ``markers_topic`` (/detections/markers), ``pose_topic`` (/landmark_pose),
+    ``map_frame`` (map), ``base_frame`` (base_link), ``max_range_m`` (4.0: farther markers are
+    ignored), ``position_std_m`` (0.03 at 1 m, growing with the square of the range) and
+    ``yaw_std_rad`` (0.05: the heading's uncertainty, whose effect on position grows with the
+    range). The heading of a fix is the current map -> base_link estimate's (tf at the image's
+    stamp; see :func:`base_pose_from_marker`), so give the fix's yaw no weight in the filter
+    (``pose0_config`` x and y only). One fix per marker seen; unknown ids, markers beyond range
+    and frames without a heading estimate yet are counted in ``ignored``.
+    """
+
+    def __init__(self, node_name: str = "landmark_fixes", **kwargs: Any) -> None:
+        super().__init__(node_name, **kwargs)
+        from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
+        from aiorobot.perception import MarkerDetectionArray
+        from aiorobot.sim import World
+        from aiorobot.tf import Buffer, TransformListener
+
+        d = self.declare_parameter
+        world = World.load(str(d("world", "box", read_only=True).value))
+        markers_topic = str(d("markers_topic", "/detections/markers", read_only=True).value)
+        pose_topic = str(d("pose_topic", "/landmark_pose", read_only=True).value)
+        self.map_frame = str(d("map_frame", "map").value)
+        self.base_frame = str(d("base_frame", "base_link").value)
+        self.max_range_m = float(d("max_range_m", 4.0).value)
+        self.position_std_m = float(d("position_std_m", 0.03).value)
+        self.yaw_std_rad = float(d("yaw_std_rad", 0.05).value)
+        self.landmarks = {lm.id: map_from_marker(lm.x, lm.y, lm.z, lm.yaw) for lm in world.landmarks}
+        self.fixes = 0
+        self.ignored = 0
+        self.buffer = Buffer()
+        self.listener = TransformListener(self.buffer, self)
+        self.pub = self.create_publisher(PoseWithCovarianceStamped, pose_topic, 10)
+        self.create_subscription(MarkerDetectionArray, markers_topic, self.on_markers, 10)
+        self._msg_type = PoseWithCovarianceStamped
+        self._base_from_optical: dict[str, NDArray[np.float64]] = {}
+
+    def __repr__(self) -> str:
+        return f"<LandmarkFixNode landmarks={len(self.landmarks)} fixes={self.fixes} ignored={self.ignored}>"
+
+    def _mount(self, frame: str) -> NDArray[np.float64] | None:
+        from aiorobot import Time
+        from aiorobot.tf import TransformException, transform_from_pq
+
+        if frame not in self._base_from_optical:
+            try:
+                t = self.buffer.lookup_transform(self.base_frame, frame, Time()).transform
+            except TransformException as err:
+                self.get_logger().warning(f"no {self.base_frame} -> {frame} yet: {err}", throttle_duration_sec=5.0)
+                return None
+            self._base_from_optical[frame] = transform_from_pq(
+                (t.translation.x, t.translation.y, t.translation.z),
+                (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w))
+        return self._base_from_optical[frame]
+
+    def _heading(self, stamp: Any) -> float | None:
+        from aiorobot import Time
+        from aiorobot.tf import TransformException
+
+        from ._geometry import transform_to_xyyaw
+
+        for when in (Time.from_msg(stamp), Time()):
+            try:
+                return transform_to_xyyaw(self.buffer.lookup_transform(self.map_frame, self.base_frame, when))[2]
+            except TransformException:
+                continue
+        return None
+
+    def on_markers(self, msg: Any) -> None:
+        from aiorobot.tf import transform_from_pq
+
+        from ._geometry import yaw_quaternion
+
+        if not msg.detections:
+            return
+        mount = self._mount(msg.header.frame_id)
+        if mount is None:
+            self.ignored += len(msg.detections)
+            return
+        for det in msg.detections:
+            where = self.landmarks.get(int(det.marker_id))
+            p, q = det.pose.position, det.pose.orientation
+            distance = math.sqrt(p.x * p.x + p.y * p.y + p.z * p.z)
+            if where is None or not distance <= self.max_range_m:
+                self.ignored += 1
+                continue
+            heading = self._heading(msg.header.stamp)
+            if heading is None:
+                self.ignored += 1
+                continue
+            x, y, yaw = base_pose_from_marker(where, transform_from_pq((p.x, p.y, p.z), (q.x, q.y, q.z, q.w)), mount,
+                                              yaw=heading)
+            out = self._msg_type()
+            out.header.stamp = msg.header.stamp
+            out.header.frame_id = self.map_frame
+            out.pose.pose.position.x, out.pose.pose.position.y = x, y
+            out.pose.pose.orientation = yaw_quaternion(yaw)
+            var_xy = (self.position_std_m * max(distance, 1.0) ** 2) ** 2 + (distance * self.yaw_std_rad) ** 2
+            cov = np.zeros(36)
+            cov[0] = cov[7] = var_xy
+            cov[14] = cov[21] = cov[28] = 1e6
+            cov[35] = self.yaw_std_rad ** 2
+            out.pose.covariance = cov
+            self.pub.publish(out)
+            self.fixes += 1
