@@ -430,7 +430,9 @@ def _copy_expr(spec: MsgSpec, cls_name: str, src: str, ns: dict[str, Any],
             binds.append(f"_v{k} = {ref}")
             args.append(_copy_expr(nested._spec, f"_C{k}", f"_v{k}", ns, get, binds))  # type: ignore[attr-defined]
         elif t.is_primitive:
-            args.append(f"_ro({ref})")
+            dtype_name = f"_D_{t.base}"
+            ns[dtype_name] = _DTYPES[t.base]
+            args.append(f"_ro({ref}, {dtype_name})")
         elif t.is_string:
             args.append(f"_FL({ref})")
         else:
