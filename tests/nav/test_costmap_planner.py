@@ -109,6 +109,55 @@ def test_astar_is_optimal_on_mazes(seed: int) -> None:
     assert not blocked[path[:, 0], path[:, 1]].any()
 
 
+def _weighted_dijkstra(cost: np.ndarray, start: tuple[int, int], goal: tuple[int, int], allow_unknown: bool) -> float:
+    """The planner's step cost, by plain Dijkstra: length * (1 + 3 * cost / 252), unknown as free when allowed."""
+    h, w = cost.shape
+    open_ = (cost < INSCRIBED_INFLATED_OBSTACLE) | ((cost == NO_INFORMATION) & allow_unknown)
+    cell = np.where(cost == NO_INFORMATION, 1.0, 1.0 + 3.0 * cost.astype(float) / 252.0)
+    dist = {start: 0.0}
+    heap = [(0.0, start)]
+    while heap:
+        d, (r, c) = heapq.heappop(heap)
+        if (r, c) == goal:
+            return d
+        if d > dist.get((r, c), math.inf):
+            continue
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                nr, nc = r + dr, c + dc
+                if (dr == dc == 0) or not (0 <= nr < h and 0 <= nc < w) or not open_[nr, nc]:
+                    continue
+                if dr and dc and not (open_[r, nc] and open_[nr, c]):
+                    continue
+                nd = d + (math.sqrt(2) if dr and dc else 1.0) * cell[nr, nc]
+                if nd < dist.get((nr, nc), math.inf):
+                    dist[(nr, nc)] = nd
+                    heapq.heappush(heap, (nd, (nr, nc)))
+    return math.inf
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("allow_unknown", [True, False])
+def test_astar_is_optimal_on_weighted_grids_with_unknown_space(seed: int, allow_unknown: bool) -> None:
+    rng = np.random.default_rng(seed)
+    h, w = rng.integers(8, 40, 2)
+    cost = (rng.random((h, w)) * 253).astype(np.uint8)  # 0..252: free with a cost
+    cost[rng.random((h, w)) < 0.2] = LETHAL_OBSTACLE
+    cost[rng.random((h, w)) < 0.1] = NO_INFORMATION
+    start, goal = (0, 0), (h - 1, w - 1)
+    cost[start] = cost[goal] = 0
+    path, total = astar(cost, 0, 0, h - 1, w - 1, 1.0, 3.0, allow_unknown)
+    expected = _weighted_dijkstra(cost, start, goal, allow_unknown)
+    if math.isinf(expected):
+        assert len(path) == 0 and math.isinf(total)
+        return
+    assert total == pytest.approx(expected, rel=1e-12)
+    assert tuple(path[0]) == start and tuple(path[-1]) == goal
+    assert np.all(np.abs(np.diff(path, axis=0)).max(axis=1) == 1)
+    cells = cost[path[:, 0], path[:, 1]]
+    assert not ((cells >= INSCRIBED_INFLATED_OBSTACLE) & ~((cells == NO_INFORMATION) & allow_unknown)).any()
+
+
 def test_plan_keeps_clear_of_obstacles_and_reports_why_it_cannot() -> None:
     static = np.zeros((80, 80), dtype=np.uint8)
     static[:, 0] = static[:, -1] = static[0, :] = static[-1, :] = LETHAL_OBSTACLE
