@@ -121,7 +121,7 @@ def build_graph(
         g.add(AmclNode(parameter_overrides={
             "robot_model_type": "omnidirectional", "set_initial_pose": True,
             "initial_pose.x": sx, "initial_pose.y": sy, "initial_pose.yaw": syaw,
-            "update_min_d": 0.1, "update_min_a": 0.1, "min_particles": 300, "max_particles": 1000, "seed": seed,
+            "update_min_d": 0.05, "update_min_a": 0.05, "min_particles": 300, "max_particles": 1000, "seed": seed,
             "alpha1": 0.05, "alpha2": 0.05, "alpha3": 0.05, "alpha4": 0.05, "alpha5": 0.05, "sigma_hit": 0.1,
         }))
     else:
