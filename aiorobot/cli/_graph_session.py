@@ -5,14 +5,16 @@ from __future__ import annotations
 import argparse
 import asyncio
 import os
+import sys
 import time
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Callable, Coroutine
 from contextlib import asynccontextmanager
 from typing import Any
 
 import numpy as np
 
 __all__ = [
+    "run_verb",
     "UserError",
     "add_graph_options",
     "call_service",
@@ -32,6 +34,32 @@ DISCOVERY_MAX_SEC = 2.0
 
 class UserError(Exception):
     """Bad input from the command line: printed as one line, exit status 1."""
+
+
+def run_verb(
+    command: str,
+    args: argparse.Namespace,
+    verb: Callable[[argparse.Namespace], Coroutine[Any, Any, int]],
+    *,
+    interrupted: int | None = None,
+) -> int:
+    """Run a graph command's verb (``aiorobot COMMAND VERB ...``) to its exit status.
+
+    A :class:`UserError` is one line on stderr, ``aiorobot COMMAND VERB: error: ...``, and
+    status 1. ``interrupted``: the status of Ctrl-C for verbs that run until stopped (``topic
+    echo``, ``tf echo``); other verbs let it reach the CLI's own handling (130).
+    """
+    from .. import run
+
+    try:
+        return run(verb(args))
+    except UserError as err:
+        print(f"aiorobot {command} {args.verb}: error: {err}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        if interrupted is None:
+            raise
+        return interrupted
 
 
 def add_graph_options(parser: argparse.ArgumentParser) -> None:

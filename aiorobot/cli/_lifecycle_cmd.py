@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import sys
 from typing import Any
 
-from ._graph_session import UserError, add_graph_options, call_service, cli_node, join_graph, remote_node_names
+from ._graph_session import UserError, add_graph_options, call_service, cli_node, join_graph, remote_node_names, run_verb
 
 __all__ = ["add_arguments", "main"]
 
@@ -35,13 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from .. import run
-
-    try:
-        return run(_main(args))
-    except UserError as err:
-        print(f"aiorobot lifecycle {args.verb}: error: {err}", file=sys.stderr)
-        return 1
+    return run_verb("lifecycle", args, _main)
 
 
 def lifecycle_nodes(rt: Any) -> list[str]:

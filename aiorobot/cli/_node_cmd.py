@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ._graph_session import UserError, add_graph_options, join_graph
+from ._graph_session import UserError, add_graph_options, join_graph, run_verb
 
 __all__ = ["add_arguments", "main"]
 
@@ -19,13 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from .. import run
-
-    try:
-        return run(_main(args))
-    except UserError as err:
-        print(f"aiorobot node {args.verb}: error: {err}", file=sys.stderr)
-        return 1
+    return run_verb("node", args, _main)
 
 
 async def _main(args: argparse.Namespace) -> int:

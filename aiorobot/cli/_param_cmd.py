@@ -21,6 +21,7 @@ from ._graph_session import (
     join_graph,
     remote_node_names,
     resolve_node,
+    run_verb,
 )
 
 __all__ = ["add_arguments", "main"]
@@ -84,13 +85,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from .. import run
-
-    try:
-        return run(_main(args))
-    except UserError as err:
-        print(f"aiorobot param {args.verb}: error: {err}", file=sys.stderr)
-        return 1
+    return run_verb("param", args, _main)
 
 
 async def _main(args: argparse.Namespace) -> int:

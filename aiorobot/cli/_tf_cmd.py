@@ -15,7 +15,7 @@ import math
 import sys
 from typing import Any
 
-from ._graph_session import UserError, add_graph_options, cli_node, join_graph
+from ._graph_session import UserError, add_graph_options, cli_node, join_graph, run_verb
 
 __all__ = ["add_arguments", "main"]
 
@@ -38,8 +38,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from .. import run
-
     for name in ("rate", "wait_time", "timeout"):
         value = getattr(args, name, None)
         if value is not None and not (value > 0 and math.isfinite(value)):
@@ -47,13 +45,7 @@ def main(args: argparse.Namespace) -> int:
             print(f"aiorobot tf {args.verb}: error: --{name.replace('_', '-')}: expected a positive number of "
                   f"{unit}, found {value}", file=sys.stderr)
             return 2
-    try:
-        return run(_main(args))
-    except UserError as err:
-        print(f"aiorobot tf {args.verb}: error: {err}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        return 0
+    return run_verb("tf", args, _main, interrupted=0)
 
 
 async def _main(args: argparse.Namespace) -> int:

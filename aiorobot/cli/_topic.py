@@ -8,7 +8,7 @@ import sys
 import time
 from typing import Any
 
-from ._graph_session import UserError, add_graph_options, fill_message, join_graph, message_to_yaml
+from ._graph_session import UserError, add_graph_options, fill_message, join_graph, message_to_yaml, run_verb
 
 __all__ = ["add_arguments", "main"]
 
@@ -37,15 +37,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from .. import run
-
-    try:
-        return run(_main(args))
-    except UserError as err:
-        print(f"aiorobot topic {args.verb}: error: {err}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        return 0
+    return run_verb("topic", args, _main, interrupted=0)
 
 
 async def _main(args: argparse.Namespace) -> int:
