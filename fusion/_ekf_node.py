@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 from collections import Counter
 from typing import Any
 
@@ -84,7 +83,7 @@ class EkfNode(Node):
         self.enabled = not p["disabled_at_startup"]
         self.inputs: list[InputConfig] = []
         self._trackers: dict[str, PoseTracker] = {}
-        self._last_input_wall = time.monotonic()
+        self._last_input_ns: int | None = None  # node clock (sim time on sim time), as robot_localization
         self._last_published_stamp = -math.inf
         # filter time is seconds since the first stamp seen: exact to the nanosecond for days
         self._origin_ns: int | None = None
@@ -239,7 +238,7 @@ class EkfNode(Node):
         except InputRejected as err:
             self._reject(cfg.name, str(err))
             return
-        self._last_input_wall = time.monotonic()
+        self._last_input_ns = self.now().nanoseconds
         applied = False
         for m in measurements:
             result = self.timeline.process(m)
@@ -352,7 +351,7 @@ class EkfNode(Node):
     def _on_period(self) -> None:
         if not (self.enabled and self.timeline.initialized):
             return
-        if time.monotonic() - self._last_input_wall > self.sensor_timeout:
+        if self._last_input_ns is None or (self.now().nanoseconds - self._last_input_ns) * 1e-9 > self.sensor_timeout:
             self.timeline.predict_to(self._now_sec())
             self.publish_state()
 

@@ -270,3 +270,24 @@ def test_config_with_a_misspelt_parameter_names_the_nearest_valid_one(tmp_path):
     )
     with pytest.raises(ConfigError, match=r'unknown robot_localization parameter "odom0_confg"; did you mean "odom0_config"\?'):
         build_nodes(load_config(path))
+
+
+async def test_sensor_timeout_is_measured_on_the_node_clock_so_it_follows_sim_time():
+    # robot_localization compares ROS time: on sim time, half a second of /clock without input is half a
+    # second, however little wall time it took (the wall clock here made the filter never predict alone).
+    from aiorobot.testing import SimClock
+
+    async with Runtime(use_sim_time=True) as rt:
+        sim = SimClock(rt, start_sec=100.0, step_sec=0.01)
+        await sim.start()
+        probe = rt.add_node(Probe())
+        quiet = rt.add_node(EkfNode("quiet", parameter_overrides={
+            "two_d_mode": True, "odom0": "/odom", "odom0_config": TWIST_CONFIG, "frequency": 50.0,
+            "sensor_timeout": 0.1, "odom_frame": "odom", "base_link_frame": "base_link",
+        }))
+        probe.odom(100.0, vx=0.5)
+        await sim.advance(0.5)
+        stamps = [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in probe.filtered]
+        assert quiet.timeline.initialized
+        assert stamps and max(stamps) >= 100.45  # predicted alone, on sim time, after 0.1 s without input
+        assert probe.filtered[-1].pose.pose.position.x == pytest.approx(0.5 * (max(stamps) - 100.0), abs=0.01)
