@@ -30,6 +30,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--world", default="warehouse", metavar="NAME|PATH", help="built-in world (warehouse, box) or a map YAML")
     parser.add_argument("--waypoints", metavar="'x,y[,yaw];...'", help="a mission of your own (default: the world's shipped one)")
     parser.add_argument("--rtf", type=_rtf, default=0.0, help="real-time factor (default 0: as fast as the machine allows)")
+    parser.add_argument("--time-source", choices=("sim", "system"), default=None,
+                        help="system: the simulator stamps with system time and every node runs on the system clock, "
+                        "as on a robot (needs --rtf 1); sim: every node follows the simulator's /clock "
+                        "(default: system at --rtf 1, else sim)")
     parser.add_argument("--seed", type=int, default=1, help="seed of every noise model (default 1)")
     parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC", help="give up after this much sim time (default 600)")
     parser.add_argument("--drive", choices=("serial", "direct"), default=None,
@@ -71,6 +75,9 @@ def main(args: argparse.Namespace) -> int:
         if drive == "serial" and args.rtf == 0:
             raise ValueError("--drive serial needs --rtf > 0 (the simulated firmware's pty runs on the wall clock); "
                              "use --rtf 1, or --drive direct")
+        if args.time_source == "system" and args.rtf != 1:
+            raise ValueError(f"--time-source system needs --rtf 1 (stamps are system time), found --rtf {args.rtf:g}; "
+                             "use --time-source sim")
         if args.localisation == "landmarks" and not args.perception:
             raise ValueError("--localisation landmarks needs perception (drop --no-perception)")
         if args.record is not None and args.record.exists():
@@ -87,14 +94,17 @@ def main(args: argparse.Namespace) -> int:
             sys.stderr.write(line + "\n")
         sys.stderr.flush()
 
+    time_source = args.time_source or ("system" if args.rtf == 1 else "sim")
     print(f"aiorobot demo: {world.name}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
           f"{args.localisation} localisation, seed {args.seed}, "
-          f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'} (Ctrl-C stops)", file=sys.stderr)
+          f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time "
+          "(Ctrl-C stops)", file=sys.stderr)
     try:
         summary = aiorobot.run(run_demo(args.world, waypoints, rtf=args.rtf, seed=args.seed, drive=drive,
                                         localisation=args.localisation, perception=args.perception,
                                         record=str(args.record) if args.record else None,
-                                        timeout_sim_sec=args.timeout, progress=progress))
+                                        timeout_sim_sec=args.timeout, progress=progress,
+                                        time_source=args.time_source))
     except KeyboardInterrupt:
         print("\naiorobot demo: interrupted", file=sys.stderr)
         return 130
@@ -126,7 +136,8 @@ def _print_summary(s: object) -> None:
         ("localisation RMSE / max vs ground truth", f"{f['localisation_rmse_m'] * 100:.1f} cm / {f['localisation_max_m'] * 100:.1f} cm"),
         ("path driven", f"{f['path_length_m']:.1f} m"),
         ("recoveries", str(f["recoveries"])),
-        ("sim time / wall time", f"{f['sim_sec']:.1f} s / {f['wall_sec']:.1f} s ({f['real_time_factor']:.1f}x real time)"),
+        ("sim time / wall time", f"{f['sim_sec']:.1f} s / {f['wall_sec']:.1f} s ({f['real_time_factor']:.1f}x real time, "
+         f"{f['time_source']} time)"),
         ("control period p50 / p99 / max", _control_text(f)),
         ("perception (ArUco worker)", "off" if f["perception_fps"] is None else
          f"{f['perception_fps']:.1f} frames/s wall, {f['perception_frames']} frames, {f['perception_dropped']} dropped"),

@@ -2,7 +2,7 @@
 
 The simulator's world and robot, AMCL localisation on the world's map, the navigation server
 (costmap, A*, Regulated Pure Pursuit, recoveries) and the asyncio BasicNavigator, in one runtime
-on sim time; a live progress line, a summary against ground truth, ``--json`` and ``--plot``.
+on sim time (on system time at real-time factor 1, as on a robot); a live progress line, a summary against ground truth, ``--json`` and ``--plot``.
 """
 
 from __future__ import annotations

@@ -4,6 +4,10 @@ Main loop: the simulator, the serial motor bridge (``drive = "serial"``), AMCL o
 fixes, perception's front ends (ArUco in a worker process, lidar segmentation in the thread pool),
 the navigation server and the navigator. Priority loop: the mecanum base controller (serial
 drive) and the EKFs (robot_localization's dual set-up, ``examples/fusion_ekf.toml``).
+
+Time: at real-time factor 1 the graph runs on system time, as on a robot (the simulator stamps
+with system time and publishes no ``/clock``; every timer keeps its own deadlines); at any other
+factor, lock-step 0 included, the simulator owns sim time and every node follows ``/clock``.
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ import tempfile
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["DRIVES", "LOCALISATIONS", "DemoGraph", "build_graph"]
+__all__ = ["DRIVES", "LOCALISATIONS", "DemoGraph", "build_graph", "time_source_for"]
 
 #: ``direct``: the simulator follows /cmd_vel (lock-step possible); ``serial``: the simulated
 #: ESP32 firmware on a pty, through SerialMotorBridge and MecanumController (real time only).
@@ -42,10 +46,17 @@ class DemoGraph:
     landmark_fixes: Any = None
     recorder: Any = None
     port_link: str | None = None
+    #: the simulator's ``time_source``: ``system`` -> run the runtime with ``use_sim_time = False``
+    time_source: str = "sim"
 
     def add(self, node: Any, executor: str = "main") -> Any:
         self.nodes.append((node, executor))
         return node
+
+
+def time_source_for(rtf: float) -> str:
+    """``system`` at exactly real time (rtf 1), as a robot on hardware runs; ``sim`` otherwise."""
+    return "system" if rtf == 1.0 else "sim"
 
 
 def _ekf_parameters(world_frame: str, *, pose: bool, start: tuple[float, float, float]) -> dict[str, Any]:
@@ -75,8 +86,13 @@ def build_graph(
     localisation: str,
     perception: bool,
     record: str | None = None,
+    time_source: str | None = None,
 ) -> DemoGraph:
-    """Construct the demo's nodes (not yet added to a runtime) for ``world`` (a loaded World)."""
+    """Construct the demo's nodes (not yet added to a runtime) for ``world`` (a loaded World).
+
+    ``time_source`` (``sim`` or ``system``, the simulator's parameter) defaults to
+    :func:`time_source_for` ``(rtf)``; the runtime must use sim time exactly when it is ``sim``.
+    """
     from aiorobot.fusion import EkfNode
     from aiorobot.nav import AmclNode, LandmarkFixNode, NavigationServer
     from aiorobot.sim import Simulator
@@ -90,12 +106,17 @@ def build_graph(
                          "use --rtf 1, or --drive direct with --rtf 0")
     if localisation == "landmarks" and not perception:
         raise ValueError("localisation 'landmarks' needs perception (the ArUco detections)")
-    g = DemoGraph()
+    if time_source not in (None, "sim", "system"):
+        raise ValueError(f"time_source: expected 'sim' or 'system', found {time_source!r}")
+    if time_source == "system" and rtf != 1.0:
+        raise ValueError(f"time_source 'system' needs a real-time factor of exactly 1 (stamps are system time), "
+                         f"found {rtf:g}; use time_source 'sim'")
+    g = DemoGraph(time_source=time_source_for(rtf) if time_source is None else time_source)
     world_ref = str(world.path) if world.path else world.name
     sim_params: dict[str, Any] = {
         "world": world_ref, "robot": "mecanum", "seed": seed, "real_time_factor": rtf,
         "publish_odom_tf": False, "camera_rate": 15.0 if perception else 0.0,
-        "drive": "serial" if drive == "serial" else "cmd_vel",
+        "drive": "serial" if drive == "serial" else "cmd_vel", "time_source": g.time_source,
     }
     if drive == "serial":
         g.port_link = os.path.join(tempfile.gettempdir(), f"aiorobot-demo-motors-{os.getpid()}")

@@ -63,6 +63,8 @@ class DemoSummary:
     real_time_factor: float = 0.0
     drive: str = "direct"
     localisation: str = "amcl"
+    #: ``sim`` (the simulator's /clock) or ``system`` (system-time stamps, at real-time factor 1)
+    time_source: str = "sim"
     #: the priority loop's control timer whose periods are measured (wall clock x rtf; None in lock-step)
     control_loop: str = ""
     control_period_nominal_ms: float | None = None
@@ -226,8 +228,14 @@ async def run_demo(
     localisation: str = "amcl",
     perception: bool = True,
     record: str | None = None,
+    time_source: str | None = None,
 ) -> DemoSummary:
     """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows.
+
+    ``time_source`` is the simulator's: ``"system"`` (needs ``rtf = 1``; the runtime then runs
+    on the system clock, as on a robot) or ``"sim"`` (every node follows the simulator's
+    ``/clock``); None picks system at ``rtf == 1`` and sim otherwise. Timeout, ``sim_sec`` and
+    the progress line count the simulator's own elapsed time either way.
 
     ``drive`` is ``"serial"`` (the simulated ESP32 firmware on a pty; needs ``rtf > 0``) or
     ``"direct"`` (the simulator follows /cmd_vel); None picks serial when ``rtf > 0``.
@@ -248,15 +256,15 @@ async def run_demo(
     if drive is None:
         drive = "serial" if rtf > 0 else "direct"
     graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
-                        record=record)
+                        record=record, time_source=time_source)
     summary = DemoSummary(world=loaded.name, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
-                          localisation=localisation)
+                          localisation=localisation, time_source=graph.time_source)
     wall0, cpu0, child0 = time.perf_counter(), time.process_time(), _children_cpu_sec()
     probe = _PeriodProbe(graph.control_node.timers[0])
     summary.control_loop = f"{graph.control_node.get_name()} {1.0 / probe.period_sec:g} Hz on the priority loop"
     sim, server = graph.simulator, graph.server
     # The simulator compiles its Numba kernels when it starts: seconds on the main loop, on purpose.
-    async with Runtime(use_sim_time=True, stall_threshold=10.0) as rt:
+    async with Runtime(use_sim_time=graph.time_source == "sim", stall_threshold=10.0) as rt:
         rt.add_nodes(graph.nodes)
         nav = rt.add_node(Navigator())
         monitor = _Monitor(rt.add_node(Node("demo_monitor")), summary)
@@ -267,7 +275,7 @@ async def run_demo(
         try:
             while not (started.done() and nav.is_task_complete()):
                 await asyncio.sleep(0.05)
-                now = rt.now().nanoseconds / 1e9
+                now = sim.time_ns / 1e9  # the simulator's elapsed time, on either time source
                 if now > timeout_sim_sec:
                     await nav.cancel_task()
                     break
@@ -291,7 +299,7 @@ async def run_demo(
                 summary.waypoints_reached = len(waypoints) - len(summary.missed)
             summary.collisions = sim.body.collisions
             summary.recoveries = server.recoveries
-            summary.sim_sec = rt.now().nanoseconds / 1e9
+            summary.sim_sec = sim.time_ns / 1e9
             wall = time.perf_counter() - wall0
             if graph.aruco is not None:
                 stats = graph.aruco.pipeline.statistics()

@@ -15,7 +15,7 @@ from ._camera import OPTICAL_FROM_LINK, CameraModel, MarkerRenderer, camera_pose
 from ._raycast import clearance_map, raycast
 from ._robot import RobotBody, make_kinematics
 from ._sensors import GRAVITY, ImuModel, LidarModel
-from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TOPICS, Simulator
+from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TIME_SOURCES, TOPICS, Simulator
 from ._world import BUILTIN_WORLDS, Landmark, World, WorldError, builtin_world_path
 from ._world_file import load_world, save_world
 
@@ -35,6 +35,7 @@ __all__ = [
     "OPTICAL_FROM_LINK",
     "RobotBody",
     "Simulator",
+    "TIME_SOURCES",
     "TOPICS",
     "World",
     "WorldError",

@@ -6,6 +6,12 @@ node waits for), publishes ``/clock``, publishes what is due, and lets every nod
 handle it before the next step. The same seed and parameters then give
 bit-identical message sequences. With ``real_time_factor > 0`` the same steps are
 paced against the wall clock.
+
+With ``time_source = "system"`` (real time only: ``real_time_factor = 1``) the simulator
+behaves as a robot's drivers do: it publishes no ``/clock``, and stamps every message and
+transform with system time, its origin taken when its loop starts plus the elapsed sim time,
+so physics stays the same per step and stamps stay monotonic; the other nodes then run on
+the system clock (``use_sim_time = false``), their timers on their own deadlines.
 """
 
 from __future__ import annotations
@@ -26,9 +32,11 @@ from ._robot import RobotBody, make_kinematics
 from ._sensors import ImuModel, LidarModel
 from ._world import World
 
-__all__ = ["CAMERA_XYZ", "FRAMES", "IMU_XYZ", "LASER_XYZ", "TOPICS", "Simulator"]
+__all__ = ["CAMERA_XYZ", "FRAMES", "IMU_XYZ", "LASER_XYZ", "TIME_SOURCES", "TOPICS", "Simulator"]
 
 _NS = 1_000_000_000
+#: ``sim``: the simulator owns time (``/clock`` from zero); ``system``: stamps are system time.
+TIME_SOURCES = ("sim", "system")
 
 #: Frames the simulator names (REP 105): static ones it broadcasts on /tf_static, parent first.
 FRAMES = {
@@ -49,7 +57,7 @@ OPTICAL_QUATERNION = (-0.5, 0.5, -0.5, 0.5)
 
 #: topic -> (message type, what it carries)
 TOPICS = {
-    "/clock": ("rosgraph_msgs/msg/Clock", "sim time (owned by the simulator)"),
+    "/clock": ("rosgraph_msgs/msg/Clock", "sim time (owned by the simulator; not with time_source = system)"),
     "/odom": ("nav_msgs/msg/Odometry", "wheel odometry odom -> base_link, drifting"),
     "/joint_states": ("sensor_msgs/msg/JointState", "wheel positions (rad) and speeds (rad/s)"),
     "/imu/data": ("sensor_msgs/msg/Imu", "gyro with bias and noise, accelerometer with gravity"),
@@ -101,6 +109,10 @@ class Simulator(Node):
         Seeds every noise model.
     real_time_factor : float
         Sim seconds per wall second; 0 runs as fast as possible and steps every node in lock-step.
+    time_source : str
+        ``sim`` (default): own the time, publish ``/clock``, stamp with sim time from zero.
+        ``system``: stamp with system time (origin at the loop's start + elapsed sim time),
+        no ``/clock``; needs ``real_time_factor = 1`` and a runtime that does not use sim time.
     duration_sec : float
         Stop the runtime after this much sim time (0: run until shut down).
     scan_rate, imu_rate, odom_rate, camera_rate, ground_truth_rate : float
@@ -115,6 +127,14 @@ class Simulator(Node):
         seed = p("seed", 1, description="seed of every noise model", read_only=True).value
         rtf = p("real_time_factor", 1.0, description="sim s per wall s; 0 = as fast as possible",
                 range=(0.0, 1000.0), read_only=True).value
+        self.time_source = p("time_source", "sim", description="sim: publish /clock and stamp with sim time; system: "
+                             "stamp with system time, no /clock (real_time_factor = 1 only)", read_only=True).value
+        if self.time_source not in TIME_SOURCES:
+            raise ValueError(f"time_source: expected one of {', '.join(map(repr, TIME_SOURCES))}, found {self.time_source!r}")
+        if self.time_source == "system" and rtf != 1.0:
+            raise ValueError(f"time_source = 'system' needs real_time_factor = 1 (stamps are system time, so sim time "
+                             f"must pass as the wall clock does), found real_time_factor = {rtf!r}; "
+                             f"use time_source = 'sim' for any other rate")
         self.duration_sec = p("duration_sec", 0.0, description="stop after this much sim time (0: never)",
                               range=(0.0, 1e9), read_only=True).value
         self.step_sec = p("step_sec", 0.01, description="longest physics step", range=(1e-4, 0.1), read_only=True).value
@@ -187,6 +207,8 @@ class Simulator(Node):
         self._renderer: MarkerRenderer | None = None
         self._streams = {name: _Stream(name, rate) for name, rate in rates.items()}
         self.time_ns = 0
+        #: added to ``time_ns`` in every stamp: 0 on sim time, system time at the loop's start on system time
+        self.stamp_origin_ns = 0
         self.steps = 0
         self.commands_received = 0
         self.commands_ignored = 0
@@ -202,7 +224,8 @@ class Simulator(Node):
         self._types = dict(clock=Clock, imu=Imu, scan=LaserScan, image=Image, info=CameraInfo, joints=JointState)
         # Reliable publishers connect to reliable and best-effort subscriptions alike.
         sensor = QoSProfile(depth=10)
-        self.clock_pub = self.create_publisher(Clock, "/clock", QoSProfile(depth=1))
+        # on system time there is no sim time to own: no /clock publisher at all, as on a robot
+        self.clock_pub = self.create_publisher(Clock, "/clock", QoSProfile(depth=1)) if self.time_source == "sim" else None
         # with drive = serial the bridge publishes /joint_states and a base controller /odom
         self.odom_pub = self.create_publisher(Odometry, "/odom", 10) if self.drive == "cmd_vel" else None
         self.joint_pub = self.create_publisher(JointState, "/joint_states", 10) if self.drive == "cmd_vel" else None
@@ -249,10 +272,15 @@ class Simulator(Node):
 
     async def on_start(self) -> None:
         runtime = self.runtime
-        if not runtime.use_sim_time:
+        if self.time_source == "sim" and not runtime.use_sim_time:
             self.get_logger().warning(
                 "the runtime does not use sim time: other nodes will not follow /clock; "
                 "set [runtime] use_sim_time = true"
+            )
+        elif self.time_source == "system" and runtime.use_sim_time:
+            self.get_logger().warning(
+                "time_source = 'system' publishes no /clock, but the runtime uses sim time: its timers "
+                "will not fire; set [runtime] use_sim_time = false"
             )
         if self.pty is not None:
             self.pty.open()
@@ -279,6 +307,8 @@ class Simulator(Node):
 
         runtime = self.runtime
         loop = asyncio.get_running_loop()
+        if self.time_source == "system":
+            self.stamp_origin_ns = self.get_clock().now().nanoseconds - self.time_ns
         self._publish_clock()
         stamp = self._stamp()
         self._publish_static(stamp)
@@ -355,9 +385,11 @@ class Simulator(Node):
     def _stamp(self) -> Any:
         from aiorobot import Time
 
-        return Time(nanoseconds=self.time_ns).to_msg()
+        return Time(nanoseconds=self.stamp_origin_ns + self.time_ns).to_msg()
 
     def _publish_clock(self, stamp: Any = None) -> None:
+        if self.clock_pub is None:
+            return
         msg = self._types["clock"]()
         msg.clock = self._stamp() if stamp is None else stamp
         self.clock_pub.publish(msg)

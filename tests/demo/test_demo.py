@@ -10,6 +10,7 @@ import pytest
 
 from aiorobot.cli import main
 from aiorobot.demo import parse_waypoints, run_demo
+from aiorobot.demo._graph import time_source_for
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -43,6 +44,10 @@ def test_cli_refuses_a_waypoint_in_a_wall_before_starting(capsys: pytest.Capture
     assert err.count("\n") == 1 and "--drive serial needs --rtf > 0" in err
     assert main(["demo", "--localisation", "landmarks", "--no-perception"]) == 2
     assert "needs perception" in capsys.readouterr().err
+    # system time only at real time: the stamps are the system clock's
+    assert main(["demo", "--world", "box", "--time-source", "system", "--rtf", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--time-source system needs --rtf 1 (stamps are system time), found --rtf 2" in err
 
 
 def test_cli_writes_the_summary_json_a_plot_and_a_bag_that_rosbags_reads(tmp_path: Path) -> None:
@@ -89,3 +94,43 @@ async def test_landmark_localisation_reaches_the_waypoints_on_aruco_fixes() -> N
     assert summary.succeeded, summary.figures()
     assert summary.landmark_fixes > 20 and summary.perception_frames > 0
     assert summary.localisation_rmse_m < 0.2  # map -> odom from the map-frame EKF on the fixes, against ground truth
+
+
+async def test_at_real_time_the_whole_graph_runs_on_system_time_and_reaches_its_waypoint(tmp_path: Path) -> None:
+    import time
+
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    assert (time_source_for(1.0), time_source_for(0.0), time_source_for(2.0)) == ("system", "sim", "sim")
+    bag = tmp_path / "bag"
+    before = time.time_ns()
+    summary = await run_demo("box", [(1.0, 0.0, 0.0)], rtf=1.0, seed=2, timeout_sim_sec=60.0, perception=False,
+                             record=str(bag))
+    after = time.time_ns()
+    assert summary.time_source == "system" and summary.drive == "serial"
+    assert summary.succeeded, summary.figures()
+    assert 0 < summary.sim_sec < 60.0 and summary.control_periods > 0
+    # every stamp in the graph is system time: the simulator's sensors, the base controller's odometry (on the
+    # priority loop), the EKF's output and tf, AMCL's pose; and no /clock
+    with AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as reader:
+        assert "/clock" not in {c.topic for c in reader.connections}
+        wanted = ("/scan", "/imu/data", "/odom", "/local/odometry/filtered", "/amcl_pose", "/tf")
+        seen: dict[str, int] = {}
+        for conn, log_ns, raw in reader.messages(connections=[c for c in reader.connections if c.topic in wanted]):
+            msg = reader.deserialize(raw, conn.msgtype)
+            header = msg.transforms[0].header if conn.topic == "/tf" else msg.header
+            stamp = header.stamp.sec * 1_000_000_000 + header.stamp.nanosec
+            # AMCL post-dates map -> odom by its transform_tolerance (1 s), as nav2_amcl does
+            assert before <= stamp <= after + 1_100_000_000 and before <= log_ns <= after, (conn.topic, stamp)
+            seen[conn.topic] = seen.get(conn.topic, 0) + 1
+    assert set(seen) == set(wanted), seen
+
+
+def test_system_time_needs_real_time_factor_1() -> None:
+    from aiorobot.demo._graph import build_graph
+    from aiorobot.sim import World
+
+    with pytest.raises(ValueError, match=r"^time_source 'system' needs a real-time factor of exactly 1 .*found 0\.5"):
+        build_graph(World.load("box"), rtf=0.5, seed=1, drive="direct", localisation="amcl", perception=False,
+                    time_source="system")

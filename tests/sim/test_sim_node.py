@@ -165,6 +165,10 @@ async def test_same_seed_gives_identical_bytes_and_another_seed_does_not() -> No
         ({"gyro_noise_std": -0.1}, r'nodes\[0\]\.parameters\.gyro_noise_std'),
         ({"world": "nowhere.yaml"}, r"nowhere\.yaml: world file not found"),
         ({"robot": "tank"}, r"robot: expected 'diff' or 'mecanum', found 'tank'"),
+        ({"time_source": "wall"}, r"time_source: expected one of 'sim', 'system', found 'wall'"),
+        ({"time_source": "system", "real_time_factor": 2.0},
+         r"time_source = 'system' needs real_time_factor = 1 .*found real_time_factor = 2\.0"),
+        ({"time_source": "system", "real_time_factor": 0.0}, r"found real_time_factor = 0\.0; use time_source = 'sim'"),
     ],
 )
 def test_bad_parameters_give_one_config_error_and_nothing_starts(tmp_path: Path, parameters: dict[str, Any], message: str) -> None:
@@ -175,6 +179,36 @@ def test_bad_parameters_give_one_config_error_and_nothing_starts(tmp_path: Path,
     path.write_text(f'[runtime]\nuse_sim_time = true\n[[nodes]]\nuse = "aiorobot.sim:Simulator"\nparameters = {{ {items} }}\n')
     with pytest.raises(ConfigError, match=message):
         build_nodes(load_config(path))
+
+
+async def test_system_time_source_stamps_with_system_time_per_step_and_publishes_no_clock() -> None:
+    import time
+
+    from aiorobot.msgs.rosgraph_msgs import Clock
+    from aiorobot.msgs.tf2_msgs import TFMessage
+
+    stamps: dict[str, list[int]] = {"/imu/data": [], "/scan": [], "/ground_truth/odom": [], "/clock": [], "/tf_static": []}
+    types = {"/imu/data": Imu, "/scan": LaserScan, "/ground_truth/odom": Odometry, "/clock": Clock, "/tf_static": TFMessage}
+    before = time.time_ns()
+    async with Runtime(handle_signals=False) as rt:  # the system clock: no use_sim_time
+        sim = rt.add_node(Simulator(parameter_overrides={"real_time_factor": 1.0, "time_source": "system",
+                                                         "duration_sec": 0.3, "camera_rate": 0.0}))
+        probe = rt.add_node(Node("probe"))
+        for topic, msg_type in types.items():
+            def record(msg: Any, topic: str = topic) -> None:
+                stamp = msg.clock if topic == "/clock" else (msg.transforms[0].header if topic == "/tf_static" else msg.header).stamp
+                stamps[topic].append(stamp.sec * 1_000_000_000 + stamp.nanosec)
+            probe.create_subscription(msg_type, topic, record, 100)
+        await rt.spin(duration_sec=30.0)  # the simulator shuts the runtime down after 0.3 s of sim time
+    after = time.time_ns()
+    assert sim.time_ns == 300_000_000 and stamps["/clock"] == []
+    assert before <= sim.stamp_origin_ns and sim.stamp_origin_ns + sim.time_ns <= after
+    for topic in ("/imu/data", "/scan", "/ground_truth/odom"):
+        got = stamps[topic]
+        assert got and got == sorted(got) and before <= got[0] and got[-1] <= after, topic
+        # physics is the same per step: a stamp is the origin plus the step's sim time
+        assert {(t - sim.stamp_origin_ns) % 10_000_000 for t in got} == {0}, topic
+    assert len(stamps["/imu/data"]) == 30 and stamps["/tf_static"] == [sim.stamp_origin_ns]
 
 
 def test_example_config_builds() -> None:
