@@ -30,6 +30,7 @@ PARTS: dict[str, str] = {
     "zenoh": "aiorobot.bench._zenoh",
     "fusion": "aiorobot.bench._fusion",
     "perception": "aiorobot.bench._perception",
+    "demo": "aiorobot.bench._demo",
 }
 
 

@@ -490,7 +490,6 @@ class Simulator(Node):
         msg.encoding = "rgb8"
         msg.step = cam.width * 3
         msg.data = image.reshape(-1)
-        self.image_pub.publish(msg)
         info = self._types["info"]()
         info.header.stamp = stamp
         info.header.frame_id = FRAMES["camera_optical"]
@@ -500,7 +499,9 @@ class Simulator(Node):
         info.k = cam.K.reshape(9)
         info.r = np.eye(3).reshape(9)
         info.p = np.hstack([cam.K, np.zeros((3, 1))]).reshape(12)
+        # the calibration first: a pipeline that needs it then has it for the very first frame
         self.info_pub.publish(info)
+        self.image_pub.publish(msg)
 
     # -- aiorobot run / sim display -------------------------------------------------------
 

@@ -34,7 +34,8 @@ def quick_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[subprocess.Comp
 def test_quick_run_succeeds_and_prints_every_table(quick_run) -> None:
     proc, _, _ = quick_run
     assert proc.returncode == 0, proc.stderr
-    for title in ("Seed experiment", "Priority loop", "Publish -> callback latency", "CPU cost", "tf"):
+    for title in ("Seed experiment", "Priority loop", "Publish -> callback latency", "CPU cost", "tf",
+                  "demo: the whole simulated robot"):
         assert title in proc.stdout
     assert "rclpy SingleThreadedExecutor" in proc.stdout
     assert "rclpy MultiThreadedExecutor + groups" in proc.stdout
@@ -72,6 +73,12 @@ def test_json_holds_every_part_model_and_kind(quick_run) -> None:
     assert [r["case"] for r in doc["parts"]["cpu"]["rows"]][1] == "100 Hz publisher"
     assert doc["parts"]["cpu"]["reference"] == {"rclpy 100 Hz publisher": 16.0}
     assert "lookups_per_sec" in doc["parts"]["tf"]
+    lockstep, realtime = doc["parts"]["demo"]["rows"]
+    assert (lockstep["time_source"], lockstep["control_period_p99_ms"]) == ("sim", None)  # no wall periods in lock-step
+    assert (realtime["time_source"], realtime["drive"]) == ("system", "serial") and realtime["control_periods"] > 0
+    for row in (lockstep, realtime):
+        assert row["waypoints_reached"] == row["waypoints_total"] > 0 and row["collisions"] == 0, row
+        assert row["perception_fps"] > 0 and row["localisation_rmse_m"] < 0.15
     for name in PARTS:
         assert "noise" in doc["parts"][name]
 
