@@ -21,7 +21,7 @@ __all__ = ["PACKAGES", "render"]
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "api.md"
 #: the packages documented, in order (aiorobot's subpackages that users import by name)
-PACKAGES = ("aiorobot", "aiorobot.tf", "aiorobot.message_filters", "aiorobot.lifecycle", "aiorobot.testing", "control")
+PACKAGES = ("aiorobot", "aiorobot.tf", "aiorobot.message_filters", "aiorobot.lifecycle", "aiorobot.testing", "aiorobot.control")
 
 
 def _first_paragraph(obj: object) -> str:
@@ -61,10 +61,7 @@ def render() -> str:
         "",
     ]
     for package in PACKAGES:
-        try:
-            module = importlib.import_module(package)
-        except ImportError:  # pragma: no cover - an optional subpackage
-            continue
+        module = importlib.import_module(package)  # every package is required: never write a truncated file
         names = list(getattr(module, "__all__", []))
         if not names:
             continue
