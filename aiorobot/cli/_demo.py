@@ -45,6 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "perception worker into the map-frame EKF")
     parser.add_argument("--no-perception", dest="perception", action="store_false",
                         help="leave out the camera, ArUco and lidar-obstacle perception (needs --localisation amcl)")
+    parser.add_argument("--realtime", action="store_true",
+                        help="run the priority loop's thread SCHED_FIFO (as ros2_control's controller manager does; needs "
+                        "root or CAP_SYS_NICE, else a warning and the run goes on)")
     parser.add_argument("--record", type=Path, metavar="DIR",
                         help="record the run's topics (raw camera frames excluded) into a rosbag2 directory with MCAP storage")
     parser.add_argument("--json", type=Path, metavar="FILE", help="write the summary's figures as JSON")
@@ -104,7 +107,7 @@ def main(args: argparse.Namespace) -> int:
                                         localisation=args.localisation, perception=args.perception,
                                         record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress,
-                                        time_source=args.time_source))
+                                        time_source=args.time_source, realtime=args.realtime))
     except KeyboardInterrupt:
         print("\naiorobot demo: interrupted", file=sys.stderr)
         return 130
@@ -139,6 +142,9 @@ def _print_summary(s: object) -> None:
         ("sim time / wall time", f"{f['sim_sec']:.1f} s / {f['wall_sec']:.1f} s ({f['real_time_factor']:.1f}x real time, "
          f"{f['time_source']} time)"),
         ("control period p50 / p99 / max", _control_text(f)),
+        *([("  a bare Python thread, same run: p99 / max",
+            f"{f['baseline_period_p99_ms']:.2f} / {f['baseline_period_max_ms']:.2f} ms")]
+          if f["baseline_period_p99_ms"] is not None else []),
         ("perception (ArUco worker)", "off" if f["perception_fps"] is None else
          f"{f['perception_fps']:.1f} frames/s wall, {f['perception_frames']} frames, {f['perception_dropped']} dropped"),
         ("CPU: main process / perception workers", f"{f['cpu_pct']:.0f} % / {f['workers_cpu_pct']:.0f} % of a core"),
@@ -149,11 +155,12 @@ def _print_summary(s: object) -> None:
         rows.append(("recorded to", f["record"]))
     for name, value in rows:
         table.add_row(name, value)
-    Console(width=100).print(table)
+    Console(width=110).print(table)
 
 
 def _control_text(f: dict) -> str:
     if f["control_period_p99_ms"] is None:
         return "n/a at --rtf 0 (lock-step); run with --rtf 1"
     return (f"{f['control_period_p50_ms']:.2f} / {f['control_period_p99_ms']:.2f} / {f['control_period_max_ms']:.2f} ms "
-            f"(nominal {f['control_period_nominal_ms']:.0f} ms, {f['control_loop'].split(' on ')[0]})")
+            f"(nominal {f['control_period_nominal_ms']:.0f} ms, {f['control_loop'].split(' on ')[0]}"
+            f"{', SCHED_FIFO' if f['realtime'] else ''})")

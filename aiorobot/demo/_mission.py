@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import gc
 import math
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -73,6 +74,12 @@ class DemoSummary:
     control_period_p99_ms: float | None = None
     control_period_max_ms: float | None = None
     control_periods: int = 0
+    #: the same periods of a bare Python thread sleeping to the same deadlines in the same run: what the machine,
+    #: its other load and the GIL give any thread of this process (the baseline the control figures compare to)
+    baseline_period_p99_ms: float | None = None
+    baseline_period_max_ms: float | None = None
+    #: the priority loop's thread runs SCHED_FIFO (``--realtime``, where the OS permits it)
+    realtime: bool = False
     #: ArUco frames processed by the worker per wall second, over the whole run
     perception_fps: float | None = None
     perception_frames: int = 0
@@ -168,6 +175,37 @@ class _Monitor:
             self.summary.localisation_max_m = float(e.max())
 
 
+class _SleepBaseline:
+    """A bare Python thread waking at absolute deadlines of ``period_sec`` (wall), recording its wake times.
+
+    Nothing of aiorobot runs in it: its lateness is the machine's scheduling and the GIL's, measured
+    beside the control timer in the same run (a baseline, as every figure here has one).
+    """
+
+    def __init__(self, period_sec: float) -> None:
+        self.period_sec = period_sec
+        self.stamps: list[int] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._main, name="aiorobot-demo-baseline", daemon=True)
+        self._thread.start()
+
+    def _main(self) -> None:
+        period_ns = int(self.period_sec * 1e9)
+        deadline = time.perf_counter_ns() + period_ns
+        while not self._stop.is_set():
+            delay = deadline - time.perf_counter_ns()
+            if delay > 0:
+                time.sleep(delay / 1e9)
+            self.stamps.append(time.perf_counter_ns())
+            deadline += period_ns
+
+    def stop(self) -> np.ndarray:
+        """Stop; the periods between wakes, in ms."""
+        self._stop.set()
+        self._thread.join()
+        return np.diff(np.asarray(self.stamps, dtype=np.int64)) / 1e6
+
+
 class _PeriodProbe:
     """Wall-clock start times of one timer's callbacks (on whichever loop the timer runs)."""
 
@@ -230,6 +268,7 @@ async def run_demo(
     perception: bool = True,
     record: str | None = None,
     time_source: str | None = None,
+    realtime: bool = False,
 ) -> DemoSummary:
     """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows.
 
@@ -242,6 +281,8 @@ async def run_demo(
     ``"direct"`` (the simulator follows /cmd_vel); None picks serial when ``rtf > 0``.
     ``localisation`` is ``"amcl"`` or ``"landmarks"`` (ArUco fixes into the map-frame EKF).
     ``record`` is a directory for a rosbag2/MCAP bag of the run's topics (raw images excluded).
+    ``realtime`` runs the priority loop's thread SCHED_FIFO where the OS permits it (as ros2_control's
+    controller manager does); otherwise a warning, and the run goes on.
     """
     from aiorobot import Node, Runtime
     from aiorobot.nav import Navigator, TaskResult, pose_stamped
@@ -270,13 +311,17 @@ async def run_demo(
     summary.control_loop = f"{graph.control_node.get_name()} {1.0 / probe.period_sec:g} Hz on the priority loop"
     sim, server = graph.simulator, graph.server
     # The simulator compiles its Numba kernels when it starts: seconds on the main loop, on purpose.
-    async with Runtime(use_sim_time=graph.time_source == "sim", stall_threshold=10.0) as rt:
+    baseline: _SleepBaseline | None = None
+    async with Runtime(use_sim_time=graph.time_source == "sim", stall_threshold=10.0, priority_realtime=realtime) as rt:
         rt.add_nodes(graph.nodes)
         nav = rt.add_node(Navigator())
         monitor = _Monitor(rt.add_node(Node("demo_monitor")), summary)
         poses = [pose_stamped(x, y, yaw) for x, y, yaw in waypoints]
         started = asyncio.ensure_future(nav.follow_waypoints(poses))
         probe_from = len(probe.stamps)
+        summary.realtime = rt.priority_loop is not None and "SCHED_FIFO" in rt.priority_loop.applied
+        if rtf > 0:
+            baseline = _SleepBaseline(probe.period_sec / rtf)
         last, last_frames, child_cpu = 0.0, 0, 0.0
         try:
             while not (started.done() and nav.is_task_complete()):
@@ -323,6 +368,11 @@ async def run_demo(
                 summary.control_period_p99_ms = float(np.percentile(sim_periods, 99))
                 summary.control_period_max_ms = float(sim_periods.max())
                 summary.control_periods = int(sim_periods.size)
+            if baseline is not None:
+                base = baseline.stop() * rtf
+                if base.size:
+                    summary.baseline_period_p99_ms = float(np.percentile(base, 99))
+                    summary.baseline_period_max_ms = float(base.max())
     gc.unfreeze()
     summary.wall_sec = time.perf_counter() - wall0
     summary.cpu_pct = 100.0 * (time.process_time() - cpu0) / max(summary.wall_sec, 1e-9)

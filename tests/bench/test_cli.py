@@ -73,10 +73,13 @@ def test_json_holds_every_part_model_and_kind(quick_run) -> None:
     assert [r["case"] for r in doc["parts"]["cpu"]["rows"]][1] == "100 Hz publisher"
     assert doc["parts"]["cpu"]["reference"] == {"rclpy 100 Hz publisher": 16.0}
     assert "lookups_per_sec" in doc["parts"]["tf"]
-    lockstep, realtime = doc["parts"]["demo"]["rows"]
+    lockstep, realtime, fifo = doc["parts"]["demo"]["rows"]
     assert (lockstep["time_source"], lockstep["control_period_p99_ms"]) == ("sim", None)  # no wall periods in lock-step
-    assert (realtime["time_source"], realtime["drive"]) == ("system", "serial") and realtime["control_periods"] > 0
-    for row in (lockstep, realtime):
+    for row in (realtime, fifo):
+        assert (row["time_source"], row["drive"]) == ("system", "serial") and row["control_periods"] > 0
+        assert row["baseline_period_p99_ms"] is not None  # the bare-thread baseline of the same run
+    assert (realtime["realtime"], "--realtime" in fifo["run"]) == (False, True)
+    for row in (lockstep, realtime, fifo):
         assert row["waypoints_reached"] == row["waypoints_total"] > 0 and row["collisions"] == 0, row
         assert row["perception_fps"] > 0 and row["localisation_rmse_m"] < 0.15
     for name in PARTS:
