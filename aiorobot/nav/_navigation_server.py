@@ -11,6 +11,13 @@ Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle
 wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason. A goal outside the
 map or in an obstacle is aborted at once with Nav2's error code and message; a cancel stops the
 base and ends CANCELED; no ``/map`` within ``map_timeout`` aborts.
+
+Localisation lost: the pose estimate on ``localization_topic`` (AMCL's ``amcl_pose``, a
+PoseWithCovarianceStamped; ``localization_type = "odometry"`` for an EKF's nav_msgs/Odometry) with a position standard deviation above
+``max_localization_std`` (m) or a heading one above ``max_localization_yaw_std`` (rad) stops the
+base at once; the goal aborts with the reason unless the estimate comes back within
+``localization_recovery_timeout`` (s). A goal that arrives while lost aborts before driving. No
+message on the topic (a graph without that estimator) means no check.
 """
 
 from __future__ import annotations
@@ -67,6 +74,11 @@ class NavigationServer(Node):
         self.wait_duration = float(d("wait_duration", 1.0).value)
         self.allow_unknown = bool(d("allow_unknown", True).value)
         self.stop_on_failure = bool(d("stop_on_failure", True).value)
+        self.localization_topic = str(d("localization_topic", "amcl_pose").value)
+        self.localization_type = str(d("localization_type", "pose").value)
+        self.max_localization_std = float(d("max_localization_std", 0.5).value)
+        self.max_localization_yaw_std = float(d("max_localization_yaw_std", 0.8).value)
+        self.localization_recovery_timeout = float(d("localization_recovery_timeout", 5.0).value)
         self.costmap_params = {
             "robot_radius": float(d("robot_radius", 0.22).value),
             "inflation_radius": float(d("inflation_radius", 0.55).value),
@@ -90,6 +102,9 @@ class NavigationServer(Node):
         self.create_subscription(LaserScan, "/scan", self._on_scan, QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=5))
         self.cmd_pub = self.create_publisher(Twist, "/cmd_vel", 10)
         self.plan_pub = self.create_publisher(Path, "/plan", 1)
+        #: why the last pose estimate counts as lost (None: fine, or no estimate seen)
+        self.localization_lost: str | None = None
+        self._subscribe_localization()
         self._busy = False
         self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
@@ -104,6 +119,32 @@ class NavigationServer(Node):
         self.map = OccupancyMap.from_msg(msg)
         self.costmap = Costmap.from_occupancy(self.map.data, self.map.width, self.map.height, self.map.resolution,
                                               self.map.origin[:2], **self.costmap_params)
+
+    def _subscribe_localization(self) -> None:
+        from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
+        from aiorobot.msgs.nav_msgs import Odometry
+
+        kinds = {"pose": PoseWithCovarianceStamped, "odometry": Odometry}
+        if self.localization_type not in kinds:
+            raise ValueError(f"parameter localization_type: expected 'pose' (PoseWithCovarianceStamped) or "
+                             f"'odometry' (nav_msgs/Odometry), found {self.localization_type!r}")
+        if self.localization_topic:
+            self.create_subscription(kinds[self.localization_type], self.localization_topic, self._on_localization, 10)
+
+    def _on_localization(self, msg: Any) -> None:
+        cov = np.asarray(msg.pose.covariance, dtype=np.float64)
+        std_xy = math.sqrt(max(float(cov[0]), float(cov[7]), 0.0))
+        std_yaw = math.sqrt(max(float(cov[35]), 0.0))
+        if not (math.isfinite(std_xy) and math.isfinite(std_yaw)):
+            self.localization_lost = f"the pose covariance on {self.localization_topic} is not finite"
+        elif std_xy > self.max_localization_std:
+            self.localization_lost = (f"position std {std_xy:.2f} m on {self.localization_topic} exceeds "
+                                      f"max_localization_std {self.max_localization_std:g} m")
+        elif std_yaw > self.max_localization_yaw_std:
+            self.localization_lost = (f"heading std {std_yaw:.2f} rad on {self.localization_topic} exceeds "
+                                      f"max_localization_yaw_std {self.max_localization_yaw_std:g} rad")
+        else:
+            self.localization_lost = None
 
     def _on_scan(self, scan: Any) -> None:
         from aiorobot import Time
@@ -289,6 +330,8 @@ class NavigationServer(Node):
 
         await self._wait_for_map()
         await self._wait_for_robot_pose()
+        if self.localization_lost is not None:
+            raise _Abort(9000, f"localisation lost: {self.localization_lost}; not driving")
         goal = xyyaw(target)
         rpp = RegulatedPurePursuit(self.rpp_params, self.costmap)
         clock = self.get_clock()
@@ -299,10 +342,27 @@ class NavigationServer(Node):
         speed = 0.0
         t = 0.0  # seconds on the node's clock since this pose began
         first_plan = True
+        lost_since: float | None = None
         while True:
             if handle.is_cancel_requested:
                 self._stop_base()
                 return False
+            if self.localization_lost is not None:
+                self._stop_base()
+                if lost_since is None:
+                    lost_since = t
+                    self.get_logger().warning(f"localisation lost ({self.localization_lost}): stopped; waiting up to "
+                                              f"{self.localization_recovery_timeout:g} s for it to come back")
+                if t - lost_since >= self.localization_recovery_timeout:
+                    raise _Abort(9000, f"localisation lost: {self.localization_lost} for "
+                                       f"{self.localization_recovery_timeout:g} s")
+                await clock.sleep_for(period)
+                t += period
+                progress_ref = (progress_ref[0], t)  # standing still for this is not a lack of progress
+                continue
+            if lost_since is not None:
+                self.get_logger().info("localisation back: driving on")
+                lost_since, last_plan_at = None, -math.inf
             pose = self._robot_pose()
             if t - last_plan_at >= self.replan_period:
                 try:

@@ -134,3 +134,60 @@ async def test_get_path_returns_a_collision_free_path(world) -> None:
     path = fut.result()
     assert path is not None and len(path.poses) > 10
     assert max(p.pose.position.y for p in path.poses) > 0.8  # over the wall's end
+
+
+def _estimate(std_xy: float, std_yaw: float = 0.1):
+    from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
+
+    msg = PoseWithCovarianceStamped()
+    msg.header.frame_id = "map"
+    cov = [0.0] * 36
+    cov[0] = cov[7] = std_xy * std_xy
+    cov[35] = std_yaw * std_yaw
+    msg.pose.covariance = cov
+    return msg
+
+
+async def test_localisation_lost_stops_the_robot_and_aborts_with_the_reason(world, sim_runtime) -> None:
+    sim, robot, server, nav = world
+    amcl = sim_runtime.add_node(Node("fake_amcl_estimate"))
+    from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
+
+    pub = amcl.create_publisher(PoseWithCovarianceStamped, "amcl_pose", 10)
+    pub.publish(_estimate(0.05))
+    assert await nav.go_to_pose(pose_stamped(1.2, -1.0, 0.0))
+    await sim.advance(2.0, step_sec=0.05)
+    assert robot.cmd != (0.0, 0.0)  # driving on a good estimate
+    moved = list(robot.pose)
+    pub.publish(_estimate(1.5))  # AMCL's particles spread: lost
+    await sim.advance(0.5, step_sec=0.05)
+    assert robot.cmd == (0.0, 0.0) and not nav.is_task_complete()  # stopped at once, waiting for it to come back
+    await _until(sim, nav, 10.0)
+    assert nav.get_result() is TaskResult.FAILED
+    assert nav.result.error_code == 9000 and "localisation lost: position std 1.50 m" in nav.result.error_msg
+    assert robot.cmd == (0.0, 0.0) and math.hypot(robot.pose[0] - moved[0], robot.pose[1] - moved[1]) < 0.3
+    # a goal sent while lost is aborted before the robot moves
+    assert await nav.go_to_pose(pose_stamped(-1.2, 0.0, 0.0))
+    await _until(sim, nav, 5.0)
+    assert nav.get_result() is TaskResult.FAILED and "not driving" in nav.result.error_msg
+
+
+async def test_localisation_back_within_the_timeout_drives_on(world, sim_runtime) -> None:
+    sim, robot, server, nav = world
+    amcl = sim_runtime.add_node(Node("fake_amcl_estimate"))
+    from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
+
+    pub = amcl.create_publisher(PoseWithCovarianceStamped, "amcl_pose", 10)
+    assert await nav.go_to_pose(pose_stamped(-1.2, 0.0, 0.0))
+    await sim.advance(1.0, step_sec=0.05)
+    pub.publish(_estimate(0.2, std_yaw=2.0))  # heading lost
+    await sim.advance(1.0, step_sec=0.05)
+    assert robot.cmd == (0.0, 0.0) and server.localization_lost is not None and "heading std" in server.localization_lost
+    pub.publish(_estimate(0.05))
+    await _until(sim, nav, 60.0)
+    assert nav.get_result() is TaskResult.SUCCEEDED
+
+
+def test_a_bad_localization_type_is_one_clear_error() -> None:
+    with pytest.raises(ValueError, match="localization_type: expected 'pose'.*found 'twist'"):
+        NavigationServer(parameter_overrides={"localization_type": "twist"})
