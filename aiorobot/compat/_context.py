@@ -12,6 +12,7 @@ runs them. Between spins nothing runs. SIGINT shuts the context down and raises
 from __future__ import annotations
 
 import asyncio
+import collections
 import os
 import signal
 import sys
@@ -64,6 +65,10 @@ class Context:
         #: the executor whose spin is running the loop (decides where plain callbacks run)
         self.executor: Any = None
         self.callbacks_done = 0
+        #: callbacks the spin in progress may still start (spin_once: one); None: no limit
+        self._admissions: int | None = None
+        self._admit_waiters: collections.deque[tuple[asyncio.Future[Any], Any, Any]] = collections.deque()
+        self._finished_waiters: list[asyncio.Future[None]] = []
 
     def __repr__(self) -> str:
         return f"<rclpy Context {'ok' if self._ok else 'shut down'} (aiorobot)>"
@@ -81,7 +86,7 @@ class Context:
                 domain_id = int(os.environ.get("ROS_DOMAIN_ID", "0") or 0)
             loop = asyncio.new_event_loop()
             runtime = Runtime(transport=settings.transport, domain_id=domain_id, handle_signals=False)
-            loop.run_until_complete(runtime.__aenter__())
+            _run(loop, runtime.__aenter__())
             for spec in settings.nodes:
                 runtime.add_node(_build_node(spec))
             # The loop only runs while a thread spins, and rclpy callbacks may block: the
@@ -126,9 +131,57 @@ class Context:
         finally:
             self._local.depth -= 1
 
+    async def admit(self, runner: Callable[[], Any] | None = None, owner: Any = None) -> Any:
+        """Wait until the spin in progress may start one more callback.
+
+        rclpy's ``spin_once`` executes one ready callback; a callback that becomes ready
+        during it (a guard condition its callback triggers, the next message) waits here
+        for the next spin, in the order it arrived. Under a custom executor's
+        ``wait_for_ready_callbacks`` a waiting plain callback (``runner``) is handed out
+        instead: the returned handler runs it wherever the executor calls it, and the
+        caller awaits that handler.
+        """
+        while self._admissions == 0:
+            waiter = asyncio.get_running_loop().create_future()
+            entry = (waiter, runner, owner)
+            self._admit_waiters.append(entry)
+            if runner is not None:
+                self.wake()  # a custom executor's wait_for_ready_callbacks may take it
+            try:
+                handler = await waiter
+            finally:
+                if entry in self._admit_waiters:
+                    self._admit_waiters.remove(entry)
+            if handler is not None:
+                return handler
+        if self._admissions is not None:
+            self._admissions -= 1
+        return None
+
+    def _open_admissions(self, admissions: int | None) -> None:
+        self._admissions = admissions
+        waiters, self._admit_waiters = self._admit_waiters, collections.deque()
+        for waiter, _runner, _owner in waiters:
+            if not waiter.done():
+                waiter.set_result(None)
+
+    def ready_runners(self) -> list[tuple[asyncio.Future[Any], Callable[[], Any], Any]]:
+        """Plain callbacks waiting to start that a custom executor may take."""
+        return [(w, r, o) for w, r, o in self._admit_waiters if r is not None and not w.done()]
+
     def callback_finished(self) -> None:
         self.callbacks_done += 1
+        waiters, self._finished_waiters = self._finished_waiters, []
+        for waiter in waiters:
+            if not waiter.done():
+                waiter.get_loop().call_soon_threadsafe(_resolve, waiter)
         self.wake()
+
+    async def next_callback_finished(self) -> None:
+        """Until some callback of the program finishes (what may change a custom group's mind)."""
+        waiter = asyncio.get_running_loop().create_future()
+        self._finished_waiters.append(waiter)
+        await waiter
 
     def wake(self) -> None:
         """Make the spin in progress re-check its condition (from any thread)."""
@@ -148,9 +201,13 @@ class Context:
             raise NotInitializedException(f"{what}: rclpy.init() has not been called (or rclpy.shutdown() was)")
 
     def spin_until(
-        self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool
+        self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool,
+        admissions: int | None = None,
     ) -> bool:
-        """Run the loop in this thread until ``done()`` or ``timeout_sec``; whether ``done()`` held."""
+        """Run the loop in this thread until ``done()`` or ``timeout_sec``; whether ``done()`` held.
+
+        ``admissions`` caps how many program callbacks may start meanwhile (``spin_once``: 1).
+        """
         self.require_ok("spin")
         loop = self.loop
         assert loop is not None
@@ -188,8 +245,11 @@ class Context:
                     finally:
                         self._waiter = None
 
+            # before the loop runs: work queued while nobody spun (a message published from
+            # the main thread) must not start ahead of the cap
+            self._open_admissions(admissions)
             try:
-                result = loop.run_until_complete(run())
+                result = _run(loop, run())
             finally:
                 self.executor = previous
                 self._spin_thread = None
@@ -290,8 +350,8 @@ class Context:
             self._closed = True
             self._restore_signal_handlers()
             try:
-                loop.run_until_complete(runtime.__aexit__(None, None, None))
-                loop.run_until_complete(loop.shutdown_asyncgens())
+                _run(loop, runtime.__aexit__(None, None, None))
+                _run(loop, loop.shutdown_asyncgens())
             finally:
                 loop.close()
                 self.loop = None
@@ -338,6 +398,25 @@ class Context:
         for sig, previous in self._saved_handlers.items():
             signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
         self._saved_handlers.clear()
+
+
+def _run(loop: asyncio.AbstractEventLoop, coro: Coroutine[Any, Any, T]) -> T:
+    """``loop.run_until_complete(coro)``, also from code running on another asyncio loop.
+
+    A program may drive rclpy from its own loop (ros2/examples' ``client_asyncio.py`` calls
+    ``rclpy.init`` and ``spin_once`` inside coroutines): rclpy's executor does not care, but
+    asyncio refuses to run a loop while the thread has a running one. That outer loop is
+    blocked for as long as this call lasts (as it is by rclpy's spin_once), so the context's
+    loop runs nested and the outer one is made the running loop again afterwards.
+    """
+    outer = asyncio.events._get_running_loop()
+    if outer is None:
+        return loop.run_until_complete(coro)
+    asyncio.events._set_running_loop(None)
+    try:
+        return loop.run_until_complete(coro)
+    finally:
+        asyncio.events._set_running_loop(outer)
 
 
 def _build_node(spec: str) -> Any:

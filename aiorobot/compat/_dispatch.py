@@ -17,10 +17,11 @@ from typing import Any
 
 from ._context import Context
 
-__all__ = ["wrap_callback"]
+__all__ = ["gate_callback", "wrap_callback"]
 
 
-def wrap_callback(context: Context, fn: Callable[..., Any] | None) -> Callable[..., Any] | None:
+def wrap_callback(context: Context, fn: Callable[..., Any] | None, owner: Any = None) -> Callable[..., Any] | None:
+    """``fn`` as the executor runs it; ``owner`` ``(node, entity slot)`` is what a custom executor is told."""
     if fn is None or getattr(fn, "_aiorobot_compat_wrapped", False):
         return fn
     if not callable(fn):
@@ -29,7 +30,11 @@ def wrap_callback(context: Context, fn: Callable[..., Any] | None) -> Callable[.
 
     @functools.wraps(fn)
     async def callback(*args: Any, **kwargs: Any) -> Any:
+        runner = None if is_async else functools.partial(context.call_as_callback, fn, *args, **kwargs)
+        handler = await context.admit(runner, owner)
         try:
+            if handler is not None:  # a custom executor took it: it runs where the executor calls it
+                return await handler
             executor = context.executor
             pool = getattr(executor, "_pool", None)
             if pool is not None and not is_async:
@@ -46,3 +51,32 @@ def wrap_callback(context: Context, fn: Callable[..., Any] | None) -> Callable[.
 
     callback._aiorobot_compat_wrapped = True  # type: ignore[attr-defined]
     return callback
+
+
+def gate_callback(context: Context, group: Any, callback: Callable[..., Any], entity: Callable[[], Any], *, coalesce: bool) -> Callable[..., Any]:
+    """``callback`` run only when the program's own ``group`` says ``beginning_execution(entity)``.
+
+    A refused call waits for the next callback of the program to finish and asks again, as
+    rclpy's executor asks on each pass. ``coalesce`` (timers): while one call waits, further
+    ones are dropped, as an rcl timer stays ready once and skips the periods it missed.
+    """
+    waiting = False
+
+    @functools.wraps(callback)
+    async def gated(*args: Any, **kwargs: Any) -> Any:
+        nonlocal waiting
+        if coalesce and waiting:
+            return None
+        waiting = True
+        try:
+            while not group.beginning_execution(entity()):
+                await context.next_callback_finished()
+        finally:
+            waiting = False
+        try:
+            return await callback(*args, **kwargs)
+        finally:
+            group.ending_execution(entity())
+
+    gated._aiorobot_compat_wrapped = True  # type: ignore[attr-defined]
+    return gated

@@ -11,7 +11,8 @@ from .._node import Node as _AioNode
 from .._qos import QoSProfile
 from .._timer import Rate as _AioRate
 from ._context import Context, default_context
-from ._dispatch import wrap_callback
+from ._dispatch import gate_callback, wrap_callback
+from .rclpy.callback_groups import CallbackGroup, is_custom
 from ._missing import not_provided
 
 __all__ = ["Client", "NodeMixin", "Rate", "make_node_class"]
@@ -19,12 +20,9 @@ __all__ = ["Client", "NodeMixin", "Rate", "make_node_class"]
 #: Node methods of rclpy that aiorobot lacks: using one raises NotProvidedError.
 MISSING_NODE_METHODS = frozenset(
     {
-        "create_guard_condition",
-        "destroy_guard_condition",
         "add_waitable",
         "remove_waitable",
         "waitables",
-        "guards",
         "handle",
         "get_publishers_info_by_topic",
         "get_subscriptions_info_by_topic",
@@ -135,10 +133,22 @@ class NodeMixin:
     def services(self) -> tuple[Any, ...]:
         return tuple(self._services)  # type: ignore[attr-defined]
 
-    def _wrap(self, callback: Any) -> Any:
+    def _wrap(self, callback: Any, group: Any = None, *, coalesce: bool = False) -> tuple[Any, list[Any]]:
+        """The callback as the executor runs it, and a one-slot list to put its entity in."""
+        slot: list[Any] = []
         if getattr(self, "_compat_raw", 0):
-            return callback  # aiorobot's own entities (action internals, parameter services)
-        return wrap_callback(self._context, callback)
+            return callback, slot  # aiorobot's own entities (action internals, parameter services)
+        wrapped = wrap_callback(self._context, callback, (self, slot))
+        if is_custom(group):
+            wrapped = gate_callback(self._context, group, wrapped, lambda: slot[0], coalesce=coalesce)
+        return wrapped, slot
+
+    @staticmethod
+    def _entity(entity: Any, slot: list[Any], group: Any) -> Any:
+        slot.append(entity)
+        if isinstance(group, CallbackGroup):
+            group.add_entity(entity)
+        return entity
 
     def create_publisher(  # type: ignore[override]
         self, msg_type: Any, topic: str, qos_profile: QoSProfile | int, *, callback_group: Any = None,
@@ -152,17 +162,21 @@ class NodeMixin:
     ) -> Any:
         if raw:
             raise not_provided("rclpy.node.Node.create_subscription(raw=True)")
-        return super().create_subscription(  # type: ignore[misc]
-            msg_type, topic, self._wrap(callback), qos_profile, callback_group=callback_group
+        wrapped, slot = self._wrap(callback, callback_group)
+        sub = super().create_subscription(  # type: ignore[misc]
+            msg_type, topic, wrapped, qos_profile, callback_group=callback_group
         )
+        return self._entity(sub, slot, callback_group)
 
     def create_timer(  # type: ignore[override]
         self, timer_period_sec: float, callback: Callable[..., Any], callback_group: Any = None,
         clock: Any = None, autostart: bool = True,
     ) -> Any:
-        return super().create_timer(  # type: ignore[misc]
-            timer_period_sec, self._wrap(callback), callback_group=callback_group, autostart=autostart
+        wrapped, slot = self._wrap(callback, callback_group, coalesce=True)
+        timer = super().create_timer(  # type: ignore[misc]
+            timer_period_sec, wrapped, callback_group=callback_group, autostart=autostart
         )
+        return self._entity(timer, slot, callback_group)
 
     def create_rate(self, frequency: float, clock: Any = None) -> Rate:  # type: ignore[override]
         return Rate(frequency)
@@ -174,9 +188,11 @@ class NodeMixin:
         self, srv_type: Any, srv_name: str, callback: Callable[..., Any], *, qos_profile: Any = None,
         callback_group: Any = None,
     ) -> Any:
-        return super().create_service(  # type: ignore[misc]
-            srv_type, srv_name, self._wrap(callback), callback_group=callback_group
+        wrapped, slot = self._wrap(callback, callback_group)
+        service = super().create_service(  # type: ignore[misc]
+            srv_type, srv_name, wrapped, callback_group=callback_group
         )
+        return self._entity(service, slot, callback_group)
 
     def create_client(  # type: ignore[override]
         self, srv_type: Any, srv_name: str, *, qos_profile: Any = None, callback_group: Any = None
@@ -192,6 +208,28 @@ class NodeMixin:
         if self._runtime is not None:  # type: ignore[attr-defined]
             self._runtime._bus.services.add(client)  # type: ignore[attr-defined]
         return client
+
+    @property
+    def guards(self) -> tuple[Any, ...]:
+        return tuple(self._guards_list())
+
+    def _guards_list(self) -> list[Any]:
+        guards = self.__dict__.get("_guards")
+        if guards is None:
+            guards = self.__dict__["_guards"] = []
+        return guards
+
+    def create_guard_condition(self, callback: Callable[[], Any], callback_group: Any = None) -> Any:
+        """A guard condition this node's executor runs ``callback`` for after each ``trigger()``."""
+        from .rclpy.guard_condition import GuardCondition
+
+        guard = GuardCondition(callback, callback_group, self._context)
+        guard._attach(self)
+        self._guards_list().append(guard)
+        return guard
+
+    def destroy_guard_condition(self, guard: Any) -> None:
+        guard.destroy()
 
     def __getattr__(self, name: str) -> Any:
         if name in MISSING_NODE_METHODS:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import asyncio
+
 import aiorobot
 from aiorobot.msgs.example_interfaces import AddTwoInts, Fibonacci
 from aiorobot.msgs.std_msgs import String
@@ -75,5 +77,25 @@ class FibonacciServer(aiorobot.Node):
         for i in range(1, goal_handle.request.order):  # type: ignore[attr-defined]
             seq.append(seq[i] + seq[i - 1])
             goal_handle.publish_feedback(Fibonacci.Feedback(sequence=seq))  # type: ignore[attr-defined]
+        goal_handle.succeed()  # type: ignore[attr-defined]
+        return Fibonacci.Result(sequence=seq)
+
+
+class SlowFibonacciServer(aiorobot.Node):
+    """As examples_rclpy_minimal_action_server/server.py: one step per period, cancel accepted."""
+
+    def __init__(self) -> None:
+        super().__init__("native_slow_fibonacci_server")
+        self.create_action_server(Fibonacci, "/fibonacci", self.execute, cancel_callback=lambda _h: True)
+
+    async def execute(self, goal_handle: object) -> Fibonacci.Result:
+        seq = [0, 1]
+        for i in range(1, goal_handle.request.order):  # type: ignore[attr-defined]
+            if goal_handle.is_cancel_requested:  # type: ignore[attr-defined]
+                goal_handle.canceled()  # type: ignore[attr-defined]
+                return Fibonacci.Result(sequence=seq)
+            seq.append(seq[i] + seq[i - 1])
+            goal_handle.publish_feedback(Fibonacci.Feedback(sequence=seq))  # type: ignore[attr-defined]
+            await asyncio.sleep(0.5)  # the upstream server's pace (1 s), halved
         goal_handle.succeed()  # type: ignore[attr-defined]
         return Fibonacci.Result(sequence=seq)

@@ -40,6 +40,26 @@ CASES = [
      ["Goal accepted :)", "Goal succeeded! Result:"], 1, True),
     ("examples_rclpy_executors/composed.py", (), ['I heard: "Hello World: 1"'], 1, False),
     ("examples_rclpy_executors/callback_group.py", (), ['I heard: "Hello World: 2"'], 1, False),
+    ("examples_rclpy_minimal_action_client/client_not_composable.py", ("FibonacciServer",),
+     ["Goal accepted :)", "Goal succeeded! Result:"], 1, True),
+    ("examples_rclpy_minimal_action_client/client_cancel.py", ("SlowFibonacciServer",),
+     ["Goal accepted :)", "Canceling goal", "Goal successfully canceled"], 1, True),
+    # its own asyncio loop drives rclpy.spin_once; two goals in parallel, then two in sequence
+    ("examples_rclpy_minimal_action_client/client_asyncio.py", ("FibonacciServer",),
+     ["unfinished: 0", "A) result", "B) result"], 1, True),
+    ("examples_rclpy_minimal_action_server/server_defer.py", ("FibonacciClient",),
+     ["Deferring execution...", "native action result: [0, 1, 1, 2] SUCCEEDED"], 1, False),
+    ("examples_rclpy_minimal_action_server/server_not_composable.py", ("FibonacciClient",),
+     ["native action result: [0, 1, 1, 2] SUCCEEDED"], 1, False),
+    ("examples_rclpy_minimal_action_server/server_queue_goals.py", ("FibonacciClient",),
+     ["native action result: [0, 1, 1, 2] SUCCEEDED"], 1, False),
+    ("examples_rclpy_minimal_action_server/server_single_goal.py", ("FibonacciClient",),
+     ["native action result: [0, 1, 1, 2] SUCCEEDED"], 1, False),
+    ("examples_rclpy_executors/talker.py", ("Listener",),
+     ['Publishing: "Hello World: 1"', "native heard: Hello World: 1"], 1, False),
+    ("examples_rclpy_executors/listener.py", ("Talker",), ['I heard: "native'], 3, False),
+    # a custom Executor whose spin_once takes work with wait_for_ready_callbacks
+    ("examples_rclpy_executors/custom_executor.py", (), ['I heard: "Hello World: 1"'], 1, False),
     ("demo_nodes_py/topics/talker.py", ("Listener",), ["Publishing: \"Hello World: 1\"", "native heard: Hello World: 1"], 1, False),
     ("demo_nodes_py/topics/listener.py", ("Talker",), ["I heard: [native"], 3, False),
     pytest.param("demo_nodes_py/services/add_two_ints_server.py", ("AddTwoIntsClient",), ["native client got: 5"], 1, False),
@@ -55,6 +75,37 @@ def test_upstream_program_runs_unmodified(script, nodes, needles, count, ends):
     code = program.finish() if ends else program.stop()
     assert code == 0, f"exit status {code}; output:\n{program.output}"
     assert "Traceback" not in program.output, program.output
+
+
+def test_guard_condition_callback_runs_in_the_next_spin_once_as_in_rclpy():
+    """trigger_guard_condition.py: the timer's spin_once ends; the next one runs the guard's callback."""
+    program = Program("examples_rclpy_guard_conditions/trigger_guard_condition.py")
+    assert program.finish() == 0, program.output
+    lines = [line.split("]: ", 1)[-1] for line in program.lines if "]: " in line]
+    assert lines == [
+        "waiting for 'spin_once' to finish...",
+        "timer callback triggered guard condition",
+        "...'spin_once' finished!",
+        "waiting for 'spin_once' to finish...",
+        "guard callback called shutdown",
+        "...'spin_once' finished!",
+    ], program.output
+
+
+def _stamps(program: Program, needle: str) -> list[float]:
+    return [float(line.split("] [")[1]) for line in program.lines if needle in line]
+
+
+def test_a_custom_callback_group_throttles_its_timer_as_in_rclpy():
+    """custom_callback_group.py: a token bucket of 10 lets the 10 Hz timer burst, then refill at 2 Hz."""
+    program = Program("examples_rclpy_executors/custom_callback_group.py", nodes=("Listener",))
+    program.wait_for('Publishing: "Hello World: 14"')
+    assert program.stop() == 0, program.output
+    stamps = _stamps(program, 'Publishing: "Hello World:')
+    burst = (stamps[9] - stamps[0]) / 9  # the bucket's 10 tokens: one per 0.1 s timer period
+    throttled = (stamps[14] - stamps[11]) / 3  # then one token per 0.5 s refill
+    assert throttled > 2.5 * burst, (burst, throttled, program.output)
+    assert "native heard: Hello World: 12" in program.output
 
 
 def test_a_missing_rclpy_name_fails_at_that_name_with_the_docs_link(tmp_path):

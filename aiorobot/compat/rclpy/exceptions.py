@@ -14,7 +14,7 @@ from ..._errors import (
 )
 
 __all__ = [
-    "InvalidNamespaceException", "InvalidNodeNameException", "InvalidParameterTypeException",
+    "InvalidHandle", "InvalidNamespaceException", "InvalidNodeNameException", "InvalidParameterTypeException",
     "InvalidParameterValueException", "InvalidServiceNameException", "InvalidTopicNameException",
     "NotInitializedException", "ParameterAlreadyDeclaredException", "ParameterImmutableException",
     "ParameterNotDeclaredException", "ParameterUninitializedException",
@@ -23,3 +23,7 @@ __all__ = [
 
 class NotInitializedException(Exception):
     """rclpy.init() has not been called, or the context was shut down."""
+
+
+class InvalidHandle(RuntimeError):
+    """An entity used after it was destroyed (rclpy raises ``rclpy._rclpy_pybind11.InvalidHandle``)."""

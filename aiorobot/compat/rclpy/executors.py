@@ -12,8 +12,10 @@ from .._context import Context, ExternalShutdownException, default_context
 from .._missing import module_getattr
 
 __all__ = [
+    "ConditionReachedException",
     "Executor",
     "ExternalShutdownException",
+    "Handler",
     "MultiThreadedExecutor",
     "ShutdownException",
     "SingleThreadedExecutor",
@@ -29,12 +31,35 @@ class TimeoutException(Exception):
     """rclpy's: a wait timed out."""
 
 
+class ConditionReachedException(Exception):
+    """rclpy's: ``wait_for_ready_callbacks``' condition held."""
+
+
+class Handler(Future[Any]):
+    """What ``wait_for_ready_callbacks`` hands out (rclpy's ``Task``): call it once to run the callback."""
+
+    def __init__(self, runner: Callable[[], Any]) -> None:
+        super().__init__()
+        self._runner: Callable[[], Any] | None = runner
+
+    def __call__(self) -> None:
+        runner, self._runner = self._runner, None
+        if runner is None:
+            return  # already run, as calling an rclpy Task twice does nothing
+        try:
+            result = runner()
+        except BaseException as err:  # delivered to the callback's task, which logs it
+            self.set_exception(err)
+        else:
+            self.set_result(result)
+
+
 class Executor:
     """rclpy's ``Executor``: ``add_node``, ``spin``, ``spin_once``, ``spin_until_future_complete``.
 
     Differences from rclpy: every node of the context is served whichever executor
-    spins (aiorobot's runtime runs the whole graph); ``spin_once`` handles the callbacks
-    ready when it runs, which may be more than one.
+    spins (aiorobot's runtime runs the whole graph). ``spin_once`` starts one callback, as
+    rclpy's; what becomes ready meanwhile waits for the next spin.
     """
 
     _pool: concurrent.futures.ThreadPoolExecutor | None = None
@@ -92,16 +117,59 @@ class Executor:
         return fut
 
     def spin(self) -> None:
+        if type(self).spin_once is not Executor.spin_once:
+            # a custom executor: rclpy's spin calls its spin_once, which takes work with
+            # wait_for_ready_callbacks
+            while self._context.ok() and not self._is_shutdown:
+                self.spin_once()
+            return
         while self._context.ok() and not self._is_shutdown:
             self._context.spin_until(self, lambda: self._is_shutdown, None, raise_on_shutdown=True)
+
+    def wait_for_ready_callbacks(
+        self, timeout_sec: float | None = None, nodes: list[Any] | None = None,
+        condition: Callable[[], bool] = lambda: False,
+    ) -> tuple[Handler, Any, Any]:
+        """The next ready plain callback as ``(handler, entity, node)``; call ``handler()`` to run it.
+
+        As rclpy's: runs the graph until a callback of ``nodes`` (default: this executor's)
+        is ready, ``TimeoutException`` after ``timeout_sec``, ``ShutdownException`` when the
+        context or executor shuts down, ``ConditionReachedException`` when ``condition()``
+        holds. The callback runs in whichever thread calls the handler; aiorobot's own work
+        (message delivery, service plumbing, ``async def`` callbacks) keeps running while
+        this waits.
+        """
+        ctx = self._context
+        if self._is_shutdown or not ctx.ok():
+            raise ShutdownException()
+        wanted = self._nodes if nodes is None else list(nodes)
+
+        def mine() -> list[Any]:
+            return [e for e in ctx.ready_runners() if e[2] is not None and e[2][0] in wanted]
+
+        ctx.spin_until(
+            self, lambda: bool(mine()) or condition() or self._is_shutdown, timeout_sec,
+            raise_on_shutdown=False, admissions=0,
+        )
+        ready = mine()
+        if ready:
+            waiter, runner, (node, slot) = ready[0]
+            handler = Handler(runner)
+            waiter.set_result(handler)
+            return handler, (slot[0] if slot else None), node
+        if self._is_shutdown or not ctx.ok():
+            raise ShutdownException()
+        if condition():
+            raise ConditionReachedException()
+        raise TimeoutException()
 
     def spin_once(self, timeout_sec: float | None = None) -> None:
         ctx = self._context
         start = ctx.callbacks_done
         if timeout_sec == 0:
-            ctx.spin_until(self, lambda: True, 0, raise_on_shutdown=True)
+            ctx.spin_until(self, lambda: True, 0, raise_on_shutdown=True, admissions=1)
             return
-        ctx.spin_until(self, lambda: ctx.callbacks_done != start, timeout_sec, raise_on_shutdown=True)
+        ctx.spin_until(self, lambda: ctx.callbacks_done != start, timeout_sec, raise_on_shutdown=True, admissions=1)
 
     def spin_until_future_complete(self, future: Any, timeout_sec: float | None = None) -> None:
         ctx = self._context
@@ -151,5 +219,5 @@ class MultiThreadedExecutor(Executor):
         self._pool = concurrent.futures.ThreadPoolExecutor(num_threads, thread_name_prefix="rclpy-executor")
 
 
-_MISSING = frozenset({"await_or_execute", "ConditionReachedException", "TaskData"})
+_MISSING = frozenset({"await_or_execute", "TaskData"})
 __getattr__ = module_getattr(__name__, "rclpy.executors", _MISSING)

@@ -19,7 +19,7 @@ __all__ = [
 
 def _wrap(node: Any, callback: Any) -> Any:
     wrap = getattr(node, "_wrap", None)
-    return callback if wrap is None or callback is None else wrap(callback)
+    return callback if wrap is None or callback is None else wrap(callback)[0]
 
 
 class ActionServer(_actions.ActionServer):
