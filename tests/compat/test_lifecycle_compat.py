@@ -25,7 +25,9 @@ from aiorobot.msgs.std_msgs import String
 
 from ._run import Program
 
-SUCCESS, FAILURE, ERROR = TransitionCallbackReturn.SUCCESS, TransitionCallbackReturn.FAILURE, TransitionCallbackReturn.ERROR
+SUCCESS = TransitionCallbackReturn.SUCCESS
+FAILURE = TransitionCallbackReturn.FAILURE
+ERROR = TransitionCallbackReturn.ERROR
 
 
 # -- the upstream program -----------------------------------------------------------------------------
@@ -57,7 +59,9 @@ def test_upstream_lifecycle_talker_walks_its_states_driven_by_its_lifecycle_serv
     assert "native notify callback: Transition from state shuttingdown to finalized" in out
     assert "driver: activate -> success True, state active" in out
     # active: the talker says it publishes, and the native listener hears exactly that
-    assert index("on_activate() is called.") < index("Lifecycle publisher is active. Publishing: [Lifecycle HelloWorld #0]")
+    assert index("on_activate() is called.") < index(
+        "Lifecycle publisher is active. Publishing: [Lifecycle HelloWorld #0]"
+    )
     assert index("Publishing: [Lifecycle HelloWorld #1]") < index("native heard: Lifecycle HelloWorld #1")
     assert "native heard: Lifecycle HelloWorld #0" in out
     # deactivated: the talker's timer goes on, its publisher says it is inactive, nothing arrives
@@ -93,7 +97,9 @@ def test_lifecycle_node_init_creates_the_services_unless_told_not_to(context):
     assert node._state_machine.service_get_transition_graph is node._service_get_transition_graph
     node.destroy_node()
     node = LifecycleNode("test_lifecycle_node_init_2", context=context, enable_communication_interface=False)
-    for name in ("change_state", "get_state", "get_available_states", "get_available_transitions", "get_transition_graph"):
+    for name in (
+        "change_state", "get_state", "get_available_states", "get_available_transitions", "get_transition_graph"
+    ):
         assert not hasattr(node, f"_service_{name}")
         assert not getattr(node._state_machine, f"service_{name}")
     node.destroy_node()
