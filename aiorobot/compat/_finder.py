@@ -33,7 +33,7 @@ _MISSING_MODULES = frozenset(
         "rclpy.impl", "rclpy.topic_endpoint_info", "rclpy.service_introspection", "rclpy.parameter_service",
         "rclpy.parameter_client", "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
-        "rclpy.time_source", "rclpy.experimental", "rclpy.lifecycle",
+        "rclpy.time_source", "rclpy.experimental",
     }
 )
 

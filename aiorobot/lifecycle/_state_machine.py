@@ -114,6 +114,10 @@ class TransitionCallbackReturn(enum.IntEnum):
     FAILURE = 98
     ERROR = 99
 
+    def to_label(self) -> str:
+        """The label of the transition this result takes (rclpy's ``to_label``): ``"transition_success"``, ..."""
+        return f"transition_{self.name.lower()}"
+
 
 @dataclass(frozen=True)
 class TransitionDescription:

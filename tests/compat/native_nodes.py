@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import asyncio
+import logging
 
 import aiorobot
 from aiorobot.msgs.example_interfaces import AddTwoInts, Fibonacci
+from aiorobot.msgs.lifecycle_msgs import ChangeState, GetState, Transition, TransitionEvent
 from aiorobot.msgs.std_msgs import String
 
 
@@ -99,3 +101,102 @@ class SlowFibonacciServer(aiorobot.Node):
             await asyncio.sleep(0.5)  # the upstream server's pace (1 s), halved
         goal_handle.succeed()  # type: ignore[attr-defined]
         return Fibonacci.Result(sequence=seq)
+class _LogWatch(logging.Handler):
+    """Sets an event on the driver's loop when another node logs a line containing ``needle``."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        super().__init__()
+        self.loop = loop
+        self.waiting: list[tuple[str, asyncio.Event]] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        text = record.getMessage()
+        for needle, event in list(self.waiting):
+            if needle in text:
+                self.loop.call_soon_threadsafe(event.set)
+
+    async def wait_for(self, needle: str) -> None:
+        event = asyncio.Event()
+        self.waiting.append((needle, event))
+        try:
+            async with asyncio.timeout(DRIVER_WAIT_SEC):
+                await event.wait()
+        finally:
+            self.waiting.remove((needle, event))
+
+
+#: generous: the machine is shared; each step normally takes at most one talker period (1 s)
+DRIVER_WAIT_SEC = 15.0
+
+
+class LifecycleTalkerDriver(aiorobot.Node):
+    """Walks lifecycle_py's ``lc_talker`` through its states by its lifecycle services, as the
+    demo's README does with ``ros2 lifecycle set``, and listens on /lifecycle_chatter."""
+
+    def __init__(self) -> None:
+        super().__init__("native_lifecycle_driver")
+        self.change_state = self.create_client(ChangeState, "/lc_talker/change_state")
+        self.get_state = self.create_client(GetState, "/lc_talker/get_state")
+        self.create_subscription(String, "/lifecycle_chatter", self.on_msg, 10)
+        # as the demo's lc_listener
+        self.create_subscription(TransitionEvent, "/lc_talker/transition_event", self.on_event, 10)
+        self.heard = 0
+        self.heard_changed = asyncio.Event()
+        self.finalized = asyncio.Event()
+
+    async def on_msg(self, msg: String) -> None:
+        self.heard += 1
+        self.heard_changed.set()
+        print(f"native heard: {msg.data}", flush=True)
+
+    async def on_event(self, event: TransitionEvent) -> None:
+        print(f"native notify callback: Transition from state {event.start_state.label} to "
+              f"{event.goal_state.label}", flush=True)
+        if event.goal_state.label == "finalized":
+            self.finalized.set()
+
+    async def state(self) -> str:
+        response = await self.get_state.call(GetState.Request(), DRIVER_WAIT_SEC)
+        return response.current_state.label
+
+    async def set(self, label: str) -> None:
+        response = await self.change_state.call(
+            ChangeState.Request(transition=Transition(label=label)), DRIVER_WAIT_SEC
+        )
+        print(f"driver: {label} -> success {response.success}, state {await self.state()}", flush=True)
+
+    async def on_start(self) -> None:
+        watch = _LogWatch(asyncio.get_running_loop())
+        talker_log = logging.getLogger("aiorobot.node.lc_talker")
+        talker_log.addHandler(watch)
+        try:
+            await self.drive(watch)
+        except TimeoutError:
+            print("driver: timed out", flush=True)
+        finally:
+            talker_log.removeHandler(watch)
+
+    async def drive(self, watch: _LogWatch) -> None:
+        async with asyncio.timeout(DRIVER_WAIT_SEC):
+            await self.change_state.wait_for_service()
+            await self.get_state.wait_for_service()
+        print(f"driver: state {await self.state()}", flush=True)
+        await self.set("activate")  # not offered by 'unconfigured': refused
+        await self.set("configure")
+        await self.set("activate")
+        async with asyncio.timeout(DRIVER_WAIT_SEC):
+            while self.heard < 2:
+                self.heard_changed.clear()
+                await self.heard_changed.wait()
+        await self.set("deactivate")
+        # Between two ticks of the talker's timer while inactive nothing may arrive (a message
+        # published before the deactivation has long been delivered by the first).
+        await watch.wait_for("Lifecycle publisher is inactive")
+        heard = self.heard
+        await watch.wait_for("Lifecycle publisher is inactive")
+        print(f"driver: heard {self.heard - heard} while inactive", flush=True)
+        await self.set("cleanup")
+        await self.set("shutdown")
+        async with asyncio.timeout(DRIVER_WAIT_SEC):
+            await self.finalized.wait()
+        print("driver: done", flush=True)

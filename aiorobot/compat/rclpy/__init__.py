@@ -131,7 +131,7 @@ _SUBMODULES = frozenset(
     {
         "action", "callback_groups", "client", "clock", "duration", "exceptions", "executors",
         "logging", "node", "parameter", "publisher", "qos", "service", "subscription", "task", "time",
-        "timer", "utilities", "signals", "context",
+        "timer", "utilities", "signals", "context", "lifecycle",
     }
 )
 _missing = module_getattr(
