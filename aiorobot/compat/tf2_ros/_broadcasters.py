@@ -23,7 +23,12 @@ class TransformBroadcaster(_tf.TransformBroadcaster):
 
 
 class StaticTransformBroadcaster(_tf.StaticTransformBroadcaster):
-    """Sends transforms on ``/tf_static`` (transient local, depth 1); every send republishes the whole set."""
+    """Sends transforms on ``/tf_static`` (transient local, depth 1); every send republishes the whole set.
+
+    rclpy difference: a transform for a child frame already sent replaces the earlier one, as
+    tf2_ros's C++ StaticTransformBroadcaster does; tf2_ros's Python one keeps the first and
+    silently drops the update.
+    """
 
     def __init__(self, node: Any, qos: QoSProfile | int | None = None) -> None:
         if qos is None:

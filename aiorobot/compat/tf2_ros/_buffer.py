@@ -94,6 +94,9 @@ class Buffer(_CoreNames, _tf.Buffer, BufferInterface):
     plain callback of a SingleThreadedExecutor; then they raise (or return) what holds, as
     tf2_ros. ``wait_for_transform_async`` returns an rclpy ``Future`` that is done with the
     transform once it is available; ``lookup_transform_async`` is a coroutine.
+
+    rclpy difference: ``Buffer(node=...)`` does not offer the ``tf2_frames`` service (aiorobot has
+    no ``tf2_msgs/srv/FrameGraph``); ``all_frames_as_yaml()`` gives the same text.
     """
 
     def __init__(self, cache_time: Any = None, node: Any = None) -> None:
@@ -149,6 +152,11 @@ class Buffer(_CoreNames, _tf.Buffer, BufferInterface):
 
         Raises LookupException, ConnectivityException, ExtrapolationException or
         InvalidArgumentException when it is still not available after ``timeout``.
+
+        rclpy difference: called from a plain callback of a SingleThreadedExecutor, the wait
+        keeps the listener (and every other callback not in the caller's mutually exclusive
+        group) running, so the transform can arrive during it; under tf2_ros the executor's
+        only thread sleeps in the callback and the lookup can only time out.
         """
         self.can_transform(target_frame, source_frame, time, timeout)
         return self.lookup_transform_core(target_frame, source_frame, time)

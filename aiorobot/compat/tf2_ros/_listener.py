@@ -19,7 +19,12 @@ class TransformListener:
     The subscriptions' callbacks run on the event loop itself (not through the executor), so
     the buffer fills whenever the loop runs: while the program spins, and while a blocking
     ``buffer.lookup_transform(..., timeout)`` waits, from whichever thread or callback.
-    ``spin_thread=True`` therefore starts no thread (see docs/rclpy-differences.md).
+    ``spin_thread=True`` therefore starts no thread.
+
+    rclpy difference: ``spin_thread=True`` starts no thread and executor of its own: one event
+    loop serves every node of the program, run by whichever thread spins or waits. A program
+    that never spins still fills the buffer during each lookup with a ``timeout``; a lookup
+    without one, between spins, sees only what arrived during earlier spins or waits.
     """
 
     def __init__(
