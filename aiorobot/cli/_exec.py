@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from collections.abc import Sequence
 
 __all__ = ["add_arguments", "main", "run_script"]
+
+#: ``package.module:function`` as in setup.py's ``console_scripts``
+_ENTRY_POINT = re.compile(r"[A-Za-z_][\w.]*:[A-Za-z_][\w.]*")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,7 +24,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--node", action="append", default=[], metavar="MODULE:CLASS",
         help="also run this aiorobot node in the program's graph (repeatable): mixed graphs",
     )
-    parser.add_argument("script", help="a ROS 2 Python program (rclpy); it runs as __main__")
+    parser.add_argument(
+        "script",
+        help="a ROS 2 Python program (rclpy); it runs as __main__. Or MODULE:FUNCTION, a console_scripts "
+        "entry point as in a package's setup.py (what `ros2 run` runs), with the module importable",
+    )
     parser.add_argument("args", nargs=argparse.REMAINDER, help="its arguments (--ros-args ... included)")
 
 
@@ -34,11 +42,15 @@ def run_script(argv: Sequence[str], *, prog: str, transport: str = "local", node
         print(f"{prog}: error: expected a script to run (e.g. {prog} talker.py)", file=sys.stderr)
         return 2
     script, *rest = argv
-    if not os.path.isfile(script):
-        print(f"{prog}: error: expected a Python file, found {script!r} (no such file)", file=sys.stderr)
+    entry_point = not os.path.exists(script) and _ENTRY_POINT.fullmatch(script) is not None
+    if not entry_point and not os.path.isfile(script):
+        print(
+            f"{prog}: error: expected a Python file or MODULE:FUNCTION, found {script!r} (no such file)",
+            file=sys.stderr,
+        )
         return 2
     from .._ros_args import RosArgsError, parse_ros_args
-    from ..compat import run_path
+    from ..compat import resolve_entry_point, run_entry_point, run_path
     from ..compat._context import settings
 
     for spec in nodes:
@@ -54,5 +66,12 @@ def run_script(argv: Sequence[str], *, prog: str, transport: str = "local", node
     except RosArgsError as err:
         print(f"{prog}: error: {err}", file=sys.stderr)
         return 2
+    if entry_point:
+        try:
+            resolve_entry_point(script)
+        except ValueError as err:
+            print(f"{prog}: error: {err}", file=sys.stderr)
+            return 2
+        return run_entry_point(script, rest)
     run_path(script, rest)
     return 0

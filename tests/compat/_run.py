@@ -25,7 +25,8 @@ class Program:
         cmd = [sys.executable, "-m", "aiorobot.cli", "exec"]
         for node in nodes:
             cmd += ["--node", f"tests.compat.native_nodes:{node}"]
-        cmd += [str(FIXTURES / script), *args]
+        # a console_scripts entry point (package.module:function) as ``ros2 run`` runs, or a fixture file
+        cmd += [script if ":" in script and not script.endswith(".py") else str(FIXTURES / script), *args]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env, cwd=FIXTURES)
         self.lines: list[str] = []
         self._eof = False

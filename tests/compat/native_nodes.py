@@ -200,3 +200,88 @@ class LifecycleTalkerDriver(aiorobot.Node):
         async with asyncio.timeout(DRIVER_WAIT_SEC):
             await self.finalized.wait()
         print("driver: done", flush=True)
+# -- tf (tests/compat/test_tf2_compat.py) ---------------------------------------------------
+
+
+def _fmt(values: tuple[float, ...]) -> str:
+    return "(" + ", ".join(f"{v:.3f}" for v in values) + ")"
+
+
+class TfEcho(aiorobot.Node):
+    """Prints every transform on /tf and /tf_static: topic, parent, child, translation, rotation."""
+
+    def __init__(self) -> None:
+        from aiorobot.msgs.tf2_msgs import TFMessage
+        from aiorobot.tf._broadcasters import DYNAMIC_QOS, STATIC_QOS
+
+        super().__init__("native_tf_echo")
+        self.create_subscription(TFMessage, "/tf", lambda m: self.echo("/tf", m), DYNAMIC_QOS)
+        self.create_subscription(TFMessage, "/tf_static", lambda m: self.echo("/tf_static", m), STATIC_QOS)
+
+    def echo(self, topic: str, msg: object) -> None:
+        for t in msg.transforms:  # type: ignore[attr-defined]
+            tr, ro = t.transform.translation, t.transform.rotation
+            print(
+                f"native tf echo {topic} {t.header.frame_id}->{t.child_frame_id} "
+                f"t={_fmt((tr.x, tr.y, tr.z))} q={_fmt((ro.x, ro.y, ro.z, ro.w))}",
+                flush=True,
+            )
+
+
+class _TfLookup(aiorobot.Node):
+    """A native aiorobot.tf Buffer + TransformListener printing one lookup every 0.2 s."""
+
+    target = ""
+    source = ""
+
+    def __init__(self) -> None:
+        from aiorobot.tf import Buffer, TransformListener
+
+        super().__init__(f"native_tf_lookup_{self.source}")
+        self.buffer = Buffer()
+        self.listener = TransformListener(self.buffer, self)
+        self.create_timer(0.2, self.tick)
+
+    async def tick(self) -> None:
+        from aiorobot import Time
+
+        if not self.buffer.can_transform(self.target, self.source, Time()):
+            return
+        t = self.buffer.lookup_transform(self.target, self.source, Time())
+        tr, ro = t.transform.translation, t.transform.rotation
+        print(
+            f"native lookup {self.target}<-{self.source} t={_fmt((tr.x, tr.y, tr.z))} "
+            f"q={_fmt((ro.x, ro.y, ro.z, ro.w))}",
+            flush=True,
+        )
+
+
+class CarrotLookup(_TfLookup):
+    target, source = "turtle1", "carrot1"
+
+
+class StaticTurtleLookup(_TfLookup):
+    target, source = "world", "mystaticturtle"
+
+
+class OdomBroadcaster(aiorobot.Node):
+    """Sends odom -> base_link on /tf at 20 Hz: 1 m along x, turned 90 degrees about z, stamped now."""
+
+    def __init__(self) -> None:
+        from aiorobot.tf import TransformBroadcaster
+
+        super().__init__("native_odom_broadcaster")
+        self.broadcaster = TransformBroadcaster(self)
+        self.create_timer(0.05, self.tick)
+
+    async def tick(self) -> None:
+        from aiorobot.msgs.geometry_msgs import TransformStamped
+
+        t = TransformStamped()
+        t.header.stamp = self.get_clock().now().to_msg()
+        t.header.frame_id = "odom"
+        t.child_frame_id = "base_link"
+        t.transform.translation.x = 1.0
+        t.transform.rotation.z = 0.7071067811865476
+        t.transform.rotation.w = 0.7071067811865476
+        self.broadcaster.send_transform(t)

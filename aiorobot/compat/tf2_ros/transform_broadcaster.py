@@ -1,0 +1,5 @@
+"""``tf2_ros.transform_broadcaster``."""
+
+from ._broadcasters import TransformBroadcaster
+
+__all__ = ["TransformBroadcaster"]
