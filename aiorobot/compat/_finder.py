@@ -24,6 +24,7 @@ _ALIASES = {
     "tf2_ros": "aiorobot.compat.tf2_ros",
     "tf2_geometry_msgs": "aiorobot.compat.tf2_geometry_msgs",
     "message_filters": "aiorobot.message_filters",
+    "sensor_msgs_py": "aiorobot.compat.sensor_msgs_py",
 }
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(

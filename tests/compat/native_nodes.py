@@ -285,3 +285,23 @@ class OdomBroadcaster(aiorobot.Node):
         t.transform.rotation.z = 0.7071067811865476
         t.transform.rotation.w = 0.7071067811865476
         self.broadcaster.send_transform(t)
+
+
+class CloudListener(aiorobot.Node):
+    """Reads pointcloud_publisher.py's /test_cloud back with aiorobot.msgs.point_cloud2."""
+
+    def __init__(self) -> None:
+        super().__init__("native_cloud_listener")
+        from aiorobot.msgs.sensor_msgs import PointCloud2
+
+        self.create_subscription(PointCloud2, "/test_cloud", self.on_cloud, 10)
+
+    async def on_cloud(self, msg: object) -> None:
+        from aiorobot.msgs import point_cloud2
+
+        xyz = point_cloud2.read_points_numpy(msg, field_names=("x", "y", "z"))
+        print(
+            f"native cloud: {msg.width}x{msg.height} in {msg.header.frame_id}, "  # type: ignore[attr-defined]
+            f"x {xyz[:, 0].min():.1f}..{xyz[:, 0].max():.1f}, |z| <= {abs(xyz[:, 2]).max():.2f}",
+            flush=True,
+        )

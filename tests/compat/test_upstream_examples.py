@@ -60,6 +60,9 @@ CASES = [
     ("examples_rclpy_executors/listener.py", ("Talker",), ['I heard: "native'], 3, False),
     # a custom Executor whose spin_once takes work with wait_for_ready_callbacks
     ("examples_rclpy_executors/custom_executor.py", (), ['I heard: "Hello World: 1"'], 1, False),
+    # sensor_msgs_py.point_cloud2.create_cloud: a 100 x 100 moving surface in z = +-0.5 m
+    ("examples_rclpy_pointcloud_publisher/pointcloud_publisher.py", ("CloudListener",),
+     ["native cloud: 10000x1 in map, x -2.0..2.0, |z| <= 0.5"], 3, False),
     ("demo_nodes_py/topics/talker.py", ("Listener",), ["Publishing: \"Hello World: 1\"", "native heard: Hello World: 1"], 1, False),
     ("demo_nodes_py/topics/listener.py", ("Talker",), ["I heard: [native"], 3, False),
     pytest.param("demo_nodes_py/services/add_two_ints_server.py", ("AddTwoIntsClient",), ["native client got: 5"], 1, False),
