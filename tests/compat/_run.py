@@ -18,11 +18,15 @@ WAIT_SEC = 20.0
 class Program:
     """``aiorobot exec [--node M:C ...] FIXTURE args``; output lines collected as they come."""
 
-    def __init__(self, script: str, *args: str, nodes: tuple[str, ...] = ()) -> None:
+    def __init__(
+        self, script: str, *args: str, nodes: tuple[str, ...] = (), exec_args: tuple[str, ...] = (),
+        extra_env: dict[str, str] | None = None,
+    ) -> None:
         env = dict(os.environ)
+        env.update(extra_env or {})
         env["PYTHONPATH"] = os.pathsep.join([str(FIXTURES), str(ROOT), env.get("PYTHONPATH", "")])
         env["PYTHONUNBUFFERED"] = "1"
-        cmd = [sys.executable, "-m", "aiorobot.cli", "exec"]
+        cmd = [sys.executable, "-m", "aiorobot.cli", "exec", *exec_args]
         for node in nodes:
             cmd += ["--node", f"tests.compat.native_nodes:{node}"]
         # a console_scripts entry point (package.module:function) as ``ros2 run`` runs, or a fixture file
