@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import asyncio
 import itertools
+import json
 import logging
 import os
 import threading
@@ -63,8 +64,26 @@ DEFAULT_LISTEN = "tcp/127.0.0.1:0"
 #: A service query waits this long at most on the zenoh side (callers time out on their own).
 QUERY_TIMEOUT_SEC = 24 * 3600.0
 WARN_INTERVAL_SEC = 1.0
+#: rmw_zenoh's defaults: a 48 MiB shared-memory pool per session, used for messages of 2 KiB and more
+#: (``ZENOH_SHM_ALLOC_SIZE`` and ``ZENOH_SHM_MESSAGE_SIZE_THRESHOLD`` change them, in bytes)
+SHM_ALLOC_SIZE = 48 * 1024 * 1024
+SHM_THRESHOLD = 2 * 1024
+SHM_MIN_CHECK = 1024  # smaller payloads are never in shared memory here: skip asking
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
+
+
+def _env_bytes(name: str, default: int) -> int:
+    raw = os.environ.get(name, "").strip()
+    if not raw:
+        return default
+    try:
+        value = int(raw)
+    except ValueError:
+        value = -1
+    if value <= 0:
+        raise ValueError(f"{name}: expected a size in bytes (a positive integer), found {raw!r}")
+    return value
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,6 +95,10 @@ class TransportStatistics:
     dropped: int
     drop_reasons: dict[str, int]
     remote_nodes: int
+    #: of ``sent``, the messages put through zenoh's shared memory (large ones, when it is enabled)
+    sent_shm: int = 0
+    #: of ``received``, the messages that arrived in shared memory (from a peer on this host)
+    received_shm: int = 0
 
 
 class _Owner:
@@ -246,7 +269,7 @@ class _Outbound:
             attachment = pack_attachment(self.seq, time.time_ns(), self.gid)
             zpub = self.zpub
         if zpub is not None:
-            zpub.put(data, attachment=attachment)
+            zpub.put(transport._payload(data), attachment=attachment)
             transport._sent += 1
 
     def close(self) -> None:
@@ -314,7 +337,10 @@ class _Inbound:
                 )
             raw = sample.attachment
             attachment = unpack_attachment(None if raw is None else raw.to_bytes())
-            msg = deserialize(sample.payload.to_bytes(), self.msg_type)
+            payload = sample.payload
+            msg = deserialize(payload.to_bytes(), self.msg_type)
+            if len(payload) >= SHM_MIN_CHECK and payload.as_shm() is not None:
+                transport._received_shm += 1
         except WireError as err:
             transport._warn("wire", f"dropped a sample on {key}: {err}")
             return
@@ -348,6 +374,12 @@ class ZenohTransport(Transport):
         ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``) applies last, as in rmw_zenoh.
     connect, listen
         Endpoints replacing the defaults.
+    shared_memory
+        ``True``/``False`` sets zenoh's ``transport/shared_memory/enabled`` (over a config
+        file too); ``None``: on with the default config, as the file says with one. When on,
+        a message whose CDR is ``shm_threshold`` bytes or more (``ZENOH_SHM_MESSAGE_SIZE_THRESHOLD``,
+        2 KiB) is put from a shared-memory pool (``ZENOH_SHM_ALLOC_SIZE``, 48 MiB), as
+        rmw_zenoh does: a peer on this host maps it instead of receiving it over the socket.
     """
 
     name = "zenoh"
@@ -359,11 +391,13 @@ class ZenohTransport(Transport):
         config_file: str | None = None,
         connect: list[str] | None = None,
         listen: list[str] | None = None,
+        shared_memory: bool | None = None,
     ) -> None:
         super().__init__(domain_id=domain_id)
         self.config_file = config_file
         self.connect = connect
         self.listen = listen
+        self.shared_memory = shared_memory
         self._session: Any = None
         self._zid = ""
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -385,6 +419,13 @@ class ZenohTransport(Transport):
         self._drops: Counter[str] = Counter()
         self._last_warning: dict[str, float] = {}
         self._hashes: dict[Any, str] = {}
+        self._shm: Any = None  # zenoh.shm.ShmProvider when the session has shared memory enabled
+        #: messages of this many bytes or more (CDR) go through shared memory, when it is enabled
+        self.shm_threshold = SHM_THRESHOLD
+        self._sent_shm = 0
+        self._received_shm = 0
+        self._drops_shm_full = 0  # sends that fell back to the network because the pool was full
+        self._shm_lock = threading.Lock()
 
     def __repr__(self) -> str:
         state = f"zid={self._zid}" if self._session is not None else "closed"
@@ -393,8 +434,6 @@ class ZenohTransport(Transport):
     # -- session --------------------------------------------------------------------
 
     def _config(self) -> Any:
-        import json
-
         import zenoh
 
         path = self.config_file or os.environ.get("ZENOH_SESSION_CONFIG_URI")
@@ -413,7 +452,12 @@ class ZenohTransport(Transport):
             # steady 1-2 kHz, for several: 3-5 ms one-way on loopback instead of ~0.2 ms. A robot's
             # graph wants latency; a config file (or ZENOH_CONFIG_OVERRIDE) can turn it back on.
             cfg.insert_json5("transport/link/tx/queue/batching/enabled", "false")
+            # Large messages (images, clouds) to peers on this host go through shared memory;
+            # zenoh falls back to the network for a peer that cannot map it.
+            cfg.insert_json5("transport/shared_memory/enabled", "true")
         cfg.insert_json5("timestamping/enabled", "true")  # the advanced publisher's cache needs it
+        if self.shared_memory is not None:
+            cfg.insert_json5("transport/shared_memory/enabled", json.dumps(bool(self.shared_memory)))
         override = os.environ.get("ZENOH_CONFIG_OVERRIDE", "")
         for item in filter(None, (part.strip() for part in override.split(";"))):
             key, sep, value = item.partition("=")
@@ -434,6 +478,7 @@ class ZenohTransport(Transport):
         cfg = self._config()
         self._session = await asyncio.to_thread(zenoh.open, cfg)
         self._zid = str(self._session.zid())
+        self._open_shm(cfg)
         bus.services.listener = self  # type: ignore[attr-defined]
         self._liveliness_sub = self._session.liveliness().declare_subscriber(
             f"@ros2_lv/{self.domain_id}/**", self._on_token, history=True
@@ -478,11 +523,48 @@ class ZenohTransport(Transport):
 
     def statistics(self) -> TransportStatistics:
         return TransportStatistics(
-            self._sent, self._received, sum(self._drops.values()), dict(self._drops), len(self._remote_nodes)
+            self._sent, self._received, sum(self._drops.values()), dict(self._drops), len(self._remote_nodes),
+            self._sent_shm, self._received_shm,
         )
 
     def remote_nodes(self) -> tuple[NodeInfo, ...]:
         return tuple(self._remote_nodes.values())
+
+    # -- shared memory --------------------------------------------------------------------
+
+    def _open_shm(self, cfg: Any) -> None:
+        """A shared-memory pool when the config enables it (rmw_zenoh's ``ZENOH_SHM_*`` settings)."""
+        try:
+            enabled = json.loads(cfg.get_json("transport/shared_memory/enabled"))
+        except Exception:  # noqa: BLE001 - a config without the key: zenoh's default (off)
+            enabled = False
+        if enabled is not True:
+            return
+        size = _env_bytes("ZENOH_SHM_ALLOC_SIZE", SHM_ALLOC_SIZE)
+        self.shm_threshold = _env_bytes("ZENOH_SHM_MESSAGE_SIZE_THRESHOLD", SHM_THRESHOLD)
+        try:
+            from zenoh.shm import ShmProvider
+
+            self._shm = ShmProvider.default_backend(size)
+        except Exception as err:  # noqa: BLE001 - no /dev/shm, a platform without it: use the network
+            _log.warning(f"zenoh shared memory is enabled but a {size}-byte pool could not be made ({err}); large messages go over the network")
+
+    def _payload(self, data: bytes) -> Any:
+        """``data`` as zenoh should send it: in a shared-memory buffer when it is large enough."""
+        shm = self._shm
+        if shm is None or len(data) < self.shm_threshold:
+            return data
+        from zenoh.shm import GarbageCollect
+
+        try:
+            with self._shm_lock:
+                buf = shm.alloc(len(data), GarbageCollect())
+        except Exception:  # noqa: BLE001 - the pool is full (subscribers still hold buffers): copy
+            self._drops_shm_full += 1
+            return data
+        buf[:] = data
+        self._sent_shm += 1
+        return buf
 
     # -- helpers --------------------------------------------------------------------------
 
