@@ -160,11 +160,9 @@ class NodeMixin:
         self, msg_type: Any, topic: str, callback: Callable[[Any], Any], qos_profile: QoSProfile | int, *,
         callback_group: Any = None, event_callbacks: Any = None, qos_overriding_options: Any = None, raw: bool = False,
     ) -> Any:
-        if raw:
-            raise not_provided("rclpy.node.Node.create_subscription(raw=True)")
         wrapped, slot = self._wrap(callback, callback_group)
         sub = super().create_subscription(  # type: ignore[misc]
-            msg_type, topic, wrapped, qos_profile, callback_group=callback_group
+            msg_type, topic, wrapped, qos_profile, callback_group=callback_group, raw=raw
         )
         return self._entity(sub, slot, callback_group)
 
