@@ -101,3 +101,20 @@ def test_async_param_client_drives_parameter_blackboard(tmp_path):
     assert loaded.count("        successful: True") == 5, program.output
     deleted = out[out.index("Deleting parameters: ") + 1:]
     assert deleted.count("        successful: True") == 3, program.output
+
+
+def test_use_logger_service_changes_the_remote_node_level():
+    program = Program("demo_nodes_py/logging/use_logger_service.py")
+    _ends_cleanly(program)
+    out = program.lines
+    levels = [line.split("Current logger level: ")[1] for line in out if "Current logger level: " in line]
+    assert levels == ["0", "10", "30", "40"], program.output
+
+    def shown(n: int) -> list[str]:
+        return [line.split("] ")[0] + "]" for line in out if f"Output {n} with" in line]
+
+    # unset: the default INFO; then DEBUG, WARN and ERROR set through ~/set_logger_levels
+    assert shown(1) == ["[INFO]", "[WARN]", "[ERROR]"], program.output
+    assert shown(2) == ["[DEBUG]", "[INFO]", "[WARN]", "[ERROR]"], program.output
+    assert shown(3) == ["[WARN]", "[ERROR]"], program.output
+    assert shown(4) == ["[ERROR]"], program.output
