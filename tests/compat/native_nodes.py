@@ -349,3 +349,21 @@ class BestEffortListener(aiorobot.Node):
 
     async def on_msg(self, msg: String) -> None:
         print(f"native heard: {msg.data}", flush=True)
+
+
+class ServiceEventEcho(aiorobot.Node):
+    """``ros2 topic echo /add_two_ints/_service_event``: one line per introspection event."""
+
+    def __init__(self) -> None:
+        super().__init__("native_service_event_echo")
+        self.create_subscription(AddTwoInts.Event, "/add_two_ints/_service_event", self.on_event, 10)
+
+    async def on_event(self, event: AddTwoInts.Event) -> None:
+        info = event.info
+        request = [(r.a, r.b) for r in event.request]
+        response = [r.sum for r in event.response]
+        print(
+            f"native event: type={info.event_type} seq={info.sequence_number} gid={bytes(info.client_gid).hex()} "
+            f"request={request} response={response}",
+            flush=True,
+        )

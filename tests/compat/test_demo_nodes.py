@@ -118,3 +118,28 @@ def test_use_logger_service_changes_the_remote_node_level():
     assert shown(2) == ["[DEBUG]", "[INFO]", "[WARN]", "[ERROR]"], program.output
     assert shown(3) == ["[WARN]", "[ERROR]"], program.output
     assert shown(4) == ["[ERROR]"], program.output
+
+
+def test_introspection_publishes_client_contents_and_service_metadata():
+    program = Program(
+        "demo_nodes_py/services/introspection.py", "--ros-args", "-p", "client_configure_introspection:=contents",
+        "-p", "service_configure_introspection:=metadata", nodes=("ServiceEventEcho",),
+    )
+    program.wait_for("Result of add_two_ints: 5", count=2)
+    code = program.stop()
+    assert code == 0, program.output
+    events = [line for line in program.lines if line.startswith("native event:") and " seq=1 " in line]
+    # REQUEST_SENT and RESPONSE_RECEIVED (client, contents), REQUEST_RECEIVED and RESPONSE_SENT (service, metadata)
+    assert [line.split(" gid=")[0] for line in events] == [f"native event: type={t} seq=1" for t in range(4)], program.output
+    assert [line.split(" request=")[1] for line in events] == [
+        "[(2, 3)] response=[]", "[] response=[]", "[] response=[]", "[] response=[5]",
+    ], program.output
+    assert len({line.split(" gid=")[1].split()[0] for line in events}) == 1, program.output  # the client's GID
+    assert "Traceback" not in program.output
+
+
+def test_introspection_disabled_by_default_publishes_nothing():
+    program = Program("demo_nodes_py/services/introspection.py", nodes=("ServiceEventEcho",))
+    program.wait_for("Result of add_two_ints: 5", count=2)
+    assert program.stop() == 0, program.output
+    assert "native event" not in program.output
