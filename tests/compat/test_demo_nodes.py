@@ -143,3 +143,10 @@ def test_introspection_disabled_by_default_publishes_nothing():
     program.wait_for("Result of add_two_ints: 5", count=2)
     assert program.stop() == 0, program.output
     assert "native event" not in program.output
+
+
+def test_matched_event_detect_fails_at_rclpy_event_handler():
+    # aiorobot has no "matched" QoS events; the program stops at the import that needs them
+    program = Program("demo_nodes_py/events/matched_event_detect.py")
+    assert program.finish() == 1
+    assert "aiorobot does not provide rclpy.event_handler yet; see https://" in program.output
