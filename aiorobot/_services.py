@@ -12,6 +12,7 @@ from __future__ import annotations
 import asyncio
 import inspect
 import threading
+import uuid
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -20,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from ._clock import _call_on
 from ._errors import ServiceError
 from ._future import Future, future_of
+from ._service_introspection import ServiceIntrospection
 
 if TYPE_CHECKING:
     from ._groups import CallbackGroup
@@ -63,11 +65,18 @@ def check_srv_type(srv_type: Any) -> None:
         )
 
 
+# service_msgs/ServiceEventInfo's event types
+_REQUEST_SENT, _REQUEST_RECEIVED, _RESPONSE_SENT, _RESPONSE_RECEIVED = range(4)
+
+
 @dataclass
 class _Call:
     request: Any
     loop: asyncio.AbstractEventLoop
     future: asyncio.Future[Any]
+    #: the calling client's GID and the call's sequence number (what introspection events carry)
+    client_gid: bytes = bytes(16)
+    sequence_number: int = 0
 
 
 class _ServiceEndpoint:
@@ -90,11 +99,24 @@ class _ServiceEndpoint:
         """The resolved service name (rclpy's ``service_name``)."""
         return self.srv_name
 
+    _introspection: ServiceIntrospection | None = None
+
     def __enter__(self) -> Any:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.destroy()  # type: ignore[attr-defined]
+
+    def configure_introspection(self, clock: Any, service_event_pub_qos: Any, introspection_state: Any) -> None:
+        """Publish this endpoint's calls on ``<service>/_service_event`` (rclpy's; see
+        :mod:`aiorobot._service_introspection`): ``ServiceIntrospectionState`` OFF, METADATA or CONTENTS."""
+        if self._introspection is None:
+            self._introspection = ServiceIntrospection(self)
+        self._introspection.configure(clock, service_event_pub_qos, introspection_state)
+
+    def _event(self, event_type: int, client_gid: bytes, sequence_number: int, request: Any = None, response: Any = None) -> None:
+        if self._introspection is not None:
+            self._introspection.emit(event_type, client_gid, sequence_number, request, response)
 
 
 class Service(_ServiceEndpoint):
@@ -178,6 +200,7 @@ class Service(_ServiceEndpoint):
         self._busy -= 1
 
     async def _handle(self, call: _Call) -> None:
+        self._event(_REQUEST_RECEIVED, call.client_gid, call.sequence_number, request=call.request)
         try:
             async with self.callback_group:
                 if self._with_response:
@@ -203,6 +226,7 @@ class Service(_ServiceEndpoint):
                 ),
             )
             return
+        self._event(_RESPONSE_SENT, call.client_gid, call.sequence_number, response=response)
         _reply(call, result=response)
 
     def _close(self) -> None:
@@ -251,6 +275,9 @@ class Client(_ServiceEndpoint):
         self.callback_group = callback_group
         self.destroyed = False
         self._pending: set[asyncio.Future[Any]] = set()
+        #: as rmw's: a GID for this client, and sequence numbers of its calls from 1
+        self.gid = uuid.uuid4().bytes
+        self._sequence = 0
 
     def __repr__(self) -> str:
         return f"<Client {self.srv_name} {self.type_name} of {self.node_name} pending={len(self._pending)}>"
@@ -315,10 +342,15 @@ class Client(_ServiceEndpoint):
         fut: asyncio.Future[Any] = loop.create_future()
         server = servers[0]
         self._pending.add(fut)
+        self._sequence += 1
+        sequence = self._sequence
         try:
-            server.node._call_soon(server._enqueue, _Call(request, loop, fut))
+            self._event(_REQUEST_SENT, self.gid, sequence, request=request)
+            server.node._call_soon(server._enqueue, _Call(request, loop, fut, self.gid, sequence))
             try:
-                return await self.node._wait_with_timeout(fut, timeout_sec)
+                response = await self.node._wait_with_timeout(fut, timeout_sec)
+                self._event(_RESPONSE_RECEIVED, self.gid, sequence, response=response)
+                return response
             except TimeoutError:
                 raise TimeoutError(
                     f"service {self.srv_name} did not answer within {timeout_sec} s"

@@ -17,6 +17,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
@@ -69,6 +70,8 @@ class Context:
         self._admissions: int | None = None
         self._admit_waiters: collections.deque[tuple[asyncio.Future[Any], Any, Any]] = collections.deque()
         self._finished_waiters: list[asyncio.Future[None]] = []
+        #: threads waiting while another executor spins in another thread (see _wait_beside)
+        self._beside = threading.Condition()
 
     def __repr__(self) -> str:
         return f"<rclpy Context {'ok' if self._ok else 'shut down'} (aiorobot)>"
@@ -185,6 +188,8 @@ class Context:
 
     def wake(self) -> None:
         """Make the spin in progress re-check its condition (from any thread)."""
+        with self._beside:
+            self._beside.notify_all()
         loop, waiter = self.loop, self._waiter
         if loop is None or waiter is None or loop.is_closed():
             return
@@ -218,7 +223,9 @@ class Context:
                     "(rclpy would deadlock here; use call_async / send_goal_async and a done callback)"
                 )
         if not self._spin_lock.acquire(blocking=False):
-            raise RuntimeError("the executor is already spinning in another thread (rclpy raises here too)")
+            if self.executor is executor or executor is None:
+                raise RuntimeError("the executor is already spinning in another thread (rclpy raises here too)")
+            return self._wait_beside(done, timeout_sec, raise_on_shutdown=raise_on_shutdown)
         shut_by_callback = False
         try:
             self._bind_thread()
@@ -264,6 +271,32 @@ class Context:
             if raise_on_shutdown and not shut_by_callback and not result:
                 raise ExternalShutdownException()
         return result
+
+    def _wait_beside(self, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool) -> bool:
+        """Another executor spins in another thread: it runs the whole graph, so wait for ``done()``.
+
+        rclpy lets two executors spin in two threads (use_logger_service.py spins one node in a
+        thread and waits on a service reply in the main one); aiorobot has one loop, which
+        the other thread is running. Returns whether ``done()`` held, as ``spin_until``.
+        """
+        deadline = None if timeout_sec is None or timeout_sec < 0 else time.monotonic() + timeout_sec
+        with self._beside:
+            while not done():
+                if not self._ok:
+                    if raise_on_shutdown:
+                        raise ExternalShutdownException()
+                    return False
+                if not self._spin_lock.locked():  # the other spin ended: spin here instead
+                    break
+                remaining = None if deadline is None else deadline - time.monotonic()
+                if remaining is not None and remaining <= 0:
+                    return False
+                # bounded, so a spin that ends without a wake() is noticed
+                self._beside.wait(0.05 if remaining is None else min(remaining, 0.05))
+            else:
+                return True
+        remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+        return self.spin_until(self.executor, done, remaining, raise_on_shutdown=raise_on_shutdown)
 
     def run_sync(self, coro: Coroutine[Any, Any, T], what: str) -> T:
         """Run ``coro`` to its end from synchronous code (rclpy's blocking calls)."""

@@ -30,9 +30,9 @@ _ALIASES = {
 _MISSING_MODULES = frozenset(
     {
         "rclpy.waitable", "rclpy.wait_for_message", "rclpy.event_handler",
-        "rclpy.qos_event", "rclpy.qos_overriding_options", "rclpy.serialization", "rclpy.type_support",
-        "rclpy.impl", "rclpy.topic_endpoint_info", "rclpy.service_introspection", "rclpy.parameter_service",
-        "rclpy.parameter_client", "rclpy.expand_topic_name", "rclpy.validate_topic_name",
+        "rclpy.qos_event", "rclpy.qos_overriding_options", "rclpy.type_support",
+        "rclpy.topic_endpoint_info", "rclpy.parameter_service",
+        "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
         "rclpy.time_source", "rclpy.experimental",
     }

@@ -28,7 +28,6 @@ MISSING_NODE_METHODS = frozenset(
         "get_subscriptions_info_by_topic",
         "get_clients_info_by_service",
         "get_servers_info_by_service",
-        "enable_logger_service",
     }
 )
 
@@ -160,11 +159,9 @@ class NodeMixin:
         self, msg_type: Any, topic: str, callback: Callable[[Any], Any], qos_profile: QoSProfile | int, *,
         callback_group: Any = None, event_callbacks: Any = None, qos_overriding_options: Any = None, raw: bool = False,
     ) -> Any:
-        if raw:
-            raise not_provided("rclpy.node.Node.create_subscription(raw=True)")
         wrapped, slot = self._wrap(callback, callback_group)
         sub = super().create_subscription(  # type: ignore[misc]
-            msg_type, topic, wrapped, qos_profile, callback_group=callback_group
+            msg_type, topic, wrapped, qos_profile, callback_group=callback_group, raw=raw
         )
         return self._entity(sub, slot, callback_group)
 
@@ -254,6 +251,10 @@ def make_node_class(base: type, name: str, module: str, doc: str) -> type:
             **extra,
         )
         NodeMixin._compat_init(self, node_name, context, cli_args, namespace, use_global_arguments, kwargs, base.__init__)
+        if enable_logger_service:
+            from ._logger_service import create_logger_services
+
+            create_logger_services(self)
 
     cls = type(name, (NodeMixin, base), {"__init__": __init__, "__doc__": doc, "__module__": module})
     return cls

@@ -772,7 +772,7 @@ class ZenohTransport(Transport):
                 query.drop()
 
         future.add_done_callback(done)
-        service.node._call_soon(service._enqueue, _Call(request, loop, future))
+        service.node._call_soon(service._enqueue, _Call(request, loop, future, attachment.gid, attachment.sequence))
 
     def _query(self, server: _RemoteServer, call: _Call) -> None:
         """Send ``call`` to a remote server; the reply completes the caller's future."""

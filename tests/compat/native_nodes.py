@@ -305,3 +305,65 @@ class CloudListener(aiorobot.Node):
             f"x {xyz[:, 0].min():.1f}..{xyz[:, 0].max():.1f}, |z| <= {abs(xyz[:, 2]).max():.2f}",
             flush=True,
         )
+
+
+class ParameterBlackboard(aiorobot.Node):
+    """demo_nodes_cpp's parameter_blackboard: takes any parameter (undeclared ones allowed)."""
+
+    def __init__(self) -> None:
+        super().__init__(
+            "parameter_blackboard", allow_undeclared_parameters=True,
+            automatically_declare_parameters_from_overrides=True,
+        )
+
+
+class SetParam1Driver(aiorobot.Node):
+    """As the README's ``ros2 service call /set_parameters_callback/set_parameters`` with param1 = 1.0,
+    then reads param1 and param2 back through get_parameters."""
+
+    def __init__(self) -> None:
+        super().__init__("native_param_driver")
+        from aiorobot.msgs.rcl_interfaces import GetParameters, SetParameters
+
+        self.set = self.create_client(SetParameters, "/set_parameters_callback/set_parameters")
+        self.get = self.create_client(GetParameters, "/set_parameters_callback/get_parameters")
+
+    async def on_start(self) -> None:
+        from aiorobot.msgs import rcl_interfaces as ri
+
+        await self.set.wait_for_service()
+        await self.get.wait_for_service()
+        value = ri.ParameterValue(type=3, double_value=1.0)
+        response = await self.set.call(ri.SetParameters.Request(parameters=[ri.Parameter(name="param1", value=value)]))
+        print(f"native set param1: {[(r.successful, r.reason) for r in response.results]}", flush=True)
+        got = await self.get.call(ri.GetParameters.Request(names=["param1", "param2"]))
+        print(f"native got: param1={got.values[0].double_value} param2={got.values[1].double_value}", flush=True)
+
+
+class BestEffortListener(aiorobot.Node):
+    """Hears /chatter with best-effort QoS (qos_profile_sensor_data): any talker_qos connects."""
+
+    def __init__(self) -> None:
+        super().__init__("native_best_effort_listener")
+        self.create_subscription(String, "/chatter", self.on_msg, aiorobot.qos_profile_sensor_data)
+
+    async def on_msg(self, msg: String) -> None:
+        print(f"native heard: {msg.data}", flush=True)
+
+
+class ServiceEventEcho(aiorobot.Node):
+    """``ros2 topic echo /add_two_ints/_service_event``: one line per introspection event."""
+
+    def __init__(self) -> None:
+        super().__init__("native_service_event_echo")
+        self.create_subscription(AddTwoInts.Event, "/add_two_ints/_service_event", self.on_event, 10)
+
+    async def on_event(self, event: AddTwoInts.Event) -> None:
+        info = event.info
+        request = [(r.a, r.b) for r in event.request]
+        response = [r.sum for r in event.response]
+        print(
+            f"native event: type={info.event_type} seq={info.sequence_number} gid={bytes(info.client_gid).hex()} "
+            f"request={request} response={response}",
+            flush=True,
+        )

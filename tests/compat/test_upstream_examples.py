@@ -112,9 +112,9 @@ def test_a_custom_callback_group_throttles_its_timer_as_in_rclpy():
 
 
 def test_a_missing_rclpy_name_fails_at_that_name_with_the_docs_link(tmp_path):
-    script = tmp_path / "uses_serialization.py"
-    script.write_text("import rclpy\nfrom rclpy.serialization import serialize_message\n")
+    script = tmp_path / "uses_type_support.py"
+    script.write_text("import rclpy\nfrom rclpy.type_support import check_for_type_support\n")
     program = Program(str(script))
     code = program.finish()
     assert code == 1
-    assert "aiorobot does not provide rclpy.serialization yet; see https://" in program.output
+    assert "aiorobot does not provide rclpy.type_support yet; see https://" in program.output

@@ -131,7 +131,8 @@ _SUBMODULES = frozenset(
     {
         "action", "callback_groups", "client", "clock", "duration", "exceptions", "executors",
         "logging", "node", "parameter", "publisher", "qos", "service", "subscription", "task", "time",
-        "timer", "utilities", "signals", "context", "lifecycle",
+        "timer", "utilities", "signals", "context", "lifecycle", "serialization",
+        "parameter_client", "impl", "service_introspection",
     }
 )
 _missing = module_getattr(

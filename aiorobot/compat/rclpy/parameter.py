@@ -1,5 +1,9 @@
-"""``rclpy.parameter``."""
+"""``rclpy.parameter``: ``Parameter``, its type, and rclpy's conversion helpers."""
 
-from ..._parameters import Parameter, ParameterType
+from ..._parameters import Parameter, ParameterType, get_parameter_value, parameter_value_to_python
+from ...parameters._files import parameter_dict_from_yaml_file
 
-__all__ = ["Parameter", "ParameterType"]
+__all__ = [
+    "Parameter", "ParameterType", "get_parameter_value", "parameter_dict_from_yaml_file",
+    "parameter_value_to_python",
+]
