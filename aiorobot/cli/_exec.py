@@ -7,6 +7,7 @@ import os
 import re
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 __all__ = ["add_arguments", "main", "run_script"]
 
@@ -66,12 +67,33 @@ def run_script(argv: Sequence[str], *, prog: str, transport: str = "local", node
     except RosArgsError as err:
         print(f"{prog}: error: {err}", file=sys.stderr)
         return 2
-    if entry_point:
-        try:
-            resolve_entry_point(script)
-        except ValueError as err:
-            print(f"{prog}: error: {err}", file=sys.stderr)
-            return 2
-        return run_entry_point(script, rest)
-    run_path(script, rest)
+    from ..compat import NotProvidedError
+
+    try:
+        if entry_point:
+            try:
+                resolve_entry_point(script)
+            except ValueError as err:
+                print(f"{prog}: error: {err}", file=sys.stderr)
+                return 2
+            return run_entry_point(script, rest)
+        run_path(script, rest)
+    except NotProvidedError as err:
+        # the program reached an rclpy name aiorobot lacks: say where, in one line
+        print(f"{prog}: {_user_frame(err.__traceback__)}{err}", file=sys.stderr)
+        return 1
     return 0
+
+
+def _user_frame(tb: Any) -> str:
+    """``file:line: `` of the innermost frame of the program's own code in ``tb`` ('' if none)."""
+    import aiorobot
+
+    ours = os.path.dirname(os.path.abspath(aiorobot.__file__))
+    where = ""
+    while tb is not None:
+        filename = tb.tb_frame.f_code.co_filename
+        if not filename.startswith("<") and not os.path.abspath(filename).startswith(ours) and "importlib" not in filename and not filename.endswith("runpy.py"):
+            where = f"{filename}:{tb.tb_lineno}: "
+        tb = tb.tb_next
+    return where

@@ -118,3 +118,15 @@ def test_a_missing_rclpy_name_fails_at_that_name_with_the_docs_link(tmp_path):
     code = program.finish()
     assert code == 1
     assert "aiorobot does not provide rclpy.type_support yet; see https://" in program.output
+    # one line, naming the program's own line that reached the name; no traceback
+    assert f"{script}:2: aiorobot does not provide" in program.output
+    assert "Traceback" not in program.output
+
+
+def test_a_missing_node_method_fails_where_the_program_calls_it(tmp_path):
+    script = tmp_path / "uses_waitables.py"
+    script.write_text("import rclpy\nrclpy.init()\nnode = rclpy.create_node('n')\nnode.add_waitable(None)\n")
+    program = Program(str(script))
+    assert program.finish() == 1
+    assert f"{script}:4: aiorobot does not provide rclpy.node.Node.add_waitable yet" in program.output
+    assert "Traceback" not in program.output
