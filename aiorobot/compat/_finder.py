@@ -29,8 +29,7 @@ _ALIASES = {
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(
     {
-        "rclpy.waitable", "rclpy.wait_for_message", "rclpy.event_handler",
-        "rclpy.qos_event", "rclpy.qos_overriding_options", "rclpy.serialization", "rclpy.type_support",
+        "rclpy.waitable", "rclpy.wait_for_message", "rclpy.serialization", "rclpy.type_support",
         "rclpy.impl", "rclpy.topic_endpoint_info", "rclpy.service_introspection", "rclpy.parameter_service",
         "rclpy.parameter_client", "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
