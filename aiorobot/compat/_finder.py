@@ -13,6 +13,7 @@ import importlib.abc
 import importlib.machinery
 import sys
 import types
+import warnings
 from typing import Any
 
 from ._missing import not_provided
@@ -36,6 +37,9 @@ _MISSING_MODULES = frozenset(
         "rclpy.time_source", "rclpy.experimental",
     }
 )
+
+#: rclpy modules rclpy itself warns about on import, and its words.
+_DEPRECATED_MODULES = {"rclpy.qos_event": "importing 'qos_event' is deprecated; import 'event_handler' instead"}
 
 
 def _msg_packages() -> frozenset[str]:
@@ -98,6 +102,8 @@ class AliasFinder(importlib.abc.MetaPathFinder):
             if fullname in _MISSING_MODULES or any(fullname.startswith(m + ".") for m in _MISSING_MODULES):
                 raise not_provided(fullname)
             target_name = _ALIASES[top] + ("." + rest if rest else "")
+            if fullname in _DEPRECATED_MODULES:
+                warnings.warn(_DEPRECATED_MODULES[fullname], UserWarning, stacklevel=2)
             try:
                 module = importlib.import_module(target_name)
             except ModuleNotFoundError as err:

@@ -1,8 +1,8 @@
-"""``rclpy.qos_event``: rclpy's deprecated name of ``rclpy.event_handler`` (warns on import, as rclpy)."""
+"""``rclpy.qos_event``: rclpy's deprecated name of ``rclpy.event_handler``.
 
-import warnings
+A program importing ``rclpy.qos_event`` gets rclpy's deprecation warning (the import
+aliases emit it, so importing this module directly stays quiet).
+"""
 
 from .event_handler import *  # noqa: F401, F403
 from .event_handler import __all__  # noqa: F401
-
-warnings.warn("importing 'qos_event' is deprecated; import 'event_handler' instead")
