@@ -13,6 +13,7 @@ import importlib.abc
 import importlib.machinery
 import sys
 import types
+import warnings
 from typing import Any
 
 from ._missing import not_provided
@@ -29,14 +30,16 @@ _ALIASES = {
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(
     {
-        "rclpy.waitable", "rclpy.wait_for_message", "rclpy.event_handler",
-        "rclpy.qos_event", "rclpy.qos_overriding_options", "rclpy.type_support",
+        "rclpy.waitable", "rclpy.wait_for_message", "rclpy.type_support",
         "rclpy.topic_endpoint_info", "rclpy.parameter_service",
         "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
         "rclpy.time_source", "rclpy.experimental",
     }
 )
+
+#: rclpy modules rclpy itself warns about on import, and its words.
+_DEPRECATED_MODULES = {"rclpy.qos_event": "importing 'qos_event' is deprecated; import 'event_handler' instead"}
 
 
 def _msg_packages() -> frozenset[str]:
@@ -99,6 +102,8 @@ class AliasFinder(importlib.abc.MetaPathFinder):
             if fullname in _MISSING_MODULES or any(fullname.startswith(m + ".") for m in _MISSING_MODULES):
                 raise not_provided(fullname)
             target_name = _ALIASES[top] + ("." + rest if rest else "")
+            if fullname in _DEPRECATED_MODULES:
+                warnings.warn(_DEPRECATED_MODULES[fullname], UserWarning, stacklevel=2)
             try:
                 module = importlib.import_module(target_name)
             except ModuleNotFoundError as err:

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import copy
+import functools
+import inspect
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from .. import _actions, _services
 from .._node import Node as _AioNode
-from .._qos import QoSProfile
+from .._event_handler import _EventCallbacks
+from .._qos import QoSProfile, to_qos_profile
 from .._timer import Rate as _AioRate
 from ._context import Context, default_context
 from ._dispatch import gate_callback, wrap_callback
@@ -149,20 +153,65 @@ class NodeMixin:
             group.add_entity(entity)
         return entity
 
+    def _wrap_events(self, event_callbacks: Any, group: Any) -> tuple[Any, dict[str, list[Any]]]:
+        """A copy of ``event_callbacks`` whose callbacks run as the program's others do, and their slots."""
+        if not isinstance(event_callbacks, _EventCallbacks):
+            return event_callbacks, {}  # None, or a wrong type aiorobot's entity names
+        from .rclpy.event_handler import rclpy_status
+
+        events = copy.copy(event_callbacks)
+        slots: dict[str, list[Any]] = {}
+        for name in events._events:
+            callback = getattr(events, name, None)
+            if callback is None or not callable(callback):
+                continue  # not callable: aiorobot's entity raises TypeError naming it
+            if inspect.iscoroutinefunction(callback):
+                async def adapted(status: Any, _cb: Any = callback) -> Any:
+                    return await _cb(rclpy_status(status))
+            else:
+                def adapted(status: Any, _cb: Any = callback) -> Any:  # type: ignore[misc]
+                    return _cb(rclpy_status(status))
+            functools.update_wrapper(adapted, callback)
+            wrapped, slots[name] = self._wrap(adapted, group)
+            setattr(events, name, wrapped)
+        return events, slots
+
+    def _add_event_entities(self, entity: Any, slots: dict[str, list[Any]], group: Any) -> None:
+        for name, slot in slots.items():
+            self._entity(entity._events[name], slot, group)  # rclpy's entity: the EventHandler
+
+    def _qos_for(self, kind: str, topic: str, qos_profile: Any, options: Any) -> QoSProfile:
+        from .rclpy.qos import frozen
+        from .rclpy.qos_overriding_options import declare_qos_parameters
+
+        qos = to_qos_profile(frozen(qos_profile))
+        if options is None:
+            return qos
+        return declare_qos_parameters(kind, self, self.resolve_topic_name(topic), qos, options)  # type: ignore[attr-defined]
+
     def create_publisher(  # type: ignore[override]
         self, msg_type: Any, topic: str, qos_profile: QoSProfile | int, *, callback_group: Any = None,
         event_callbacks: Any = None, qos_overriding_options: Any = None, publisher_class: Any = None,
     ) -> Any:
-        return super().create_publisher(msg_type, topic, qos_profile)  # type: ignore[misc]
+        qos = self._qos_for("publisher", topic, qos_profile, qos_overriding_options)
+        events, slots = self._wrap_events(event_callbacks, callback_group)
+        pub = super().create_publisher(  # type: ignore[misc]
+            msg_type, topic, qos, callback_group=callback_group, event_callbacks=events
+        )
+        self._add_event_entities(pub, slots, callback_group)
+        return pub
 
     def create_subscription(  # type: ignore[override]
         self, msg_type: Any, topic: str, callback: Callable[[Any], Any], qos_profile: QoSProfile | int, *,
         callback_group: Any = None, event_callbacks: Any = None, qos_overriding_options: Any = None, raw: bool = False,
     ) -> Any:
+        qos = self._qos_for("subscription", topic, qos_profile, qos_overriding_options)
         wrapped, slot = self._wrap(callback, callback_group)
+        events, slots = self._wrap_events(event_callbacks, callback_group)
         sub = super().create_subscription(  # type: ignore[misc]
-            msg_type, topic, wrapped, qos_profile, callback_group=callback_group, raw=raw
+            msg_type, topic, wrapped, qos, callback_group=callback_group, event_callbacks=events, raw=raw
         )
+        self._add_event_entities(sub, slots, callback_group)
         return self._entity(sub, slot, callback_group)
 
     def create_timer(  # type: ignore[override]
@@ -170,6 +219,10 @@ class NodeMixin:
         clock: Any = None, autostart: bool = True,
     ) -> Any:
         wrapped, slot = self._wrap(callback, callback_group, coalesce=True)
+        if timer_period_sec == 0 and not isinstance(timer_period_sec, bool):
+            # rcl takes a zero period (a timer ready on every pass of the executor, as
+            # deadline.py's `--pause-for 0` makes); aiorobot's timers want > 0: the shortest one
+            timer_period_sec = 1e-9
         timer = super().create_timer(  # type: ignore[misc]
             timer_period_sec, wrapped, callback_group=callback_group, autostart=autostart
         )

@@ -1,0 +1,122 @@
+"""``rclpy.event_handler``: QoS event callbacks, over aiorobot._event_handler.
+
+The callbacks given here are the program's: the compat node runs them as it runs the
+program's other callbacks (in the spinning thread, under the entity's callback group),
+and an incompatible-QoS status's ``last_policy_kind`` prints as rclpy's does
+(``rmw_qos_policy_kind_t.RMW_QOS_POLICY_DURABILITY``) while staying an int that
+``qos_policy_name_from_kind`` takes.
+
+rclpy differences: no ``matched`` events (passing ``matched=`` raises
+``NotProvidedError``), and no default incompatible-QoS/type callbacks: the runtime logs one
+warning naming both endpoints of a pair that does not connect (docs/rclpy-differences.md).
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable
+from typing import Any
+
+from ... import _event_handler as _eh
+from ..._event_handler import (
+    EventHandler,
+    IncompatibleTypeInfo,
+    QoSLivelinessChangedInfo,
+    QoSLivelinessLostInfo,
+    QoSMessageLostInfo,
+    QoSOfferedDeadlineMissedInfo,
+    QoSOfferedIncompatibleQoSInfo,
+    QoSPublisherEventType,
+    QoSRequestedDeadlineMissedInfo,
+    QoSRequestedIncompatibleQoSInfo,
+    QoSSubscriptionEventType,
+)
+from .._missing import module_getattr, not_provided
+
+__all__ = [
+    "EventHandler", "IncompatibleTypeInfo", "PublisherEventCallbacks", "QoSEventHandler",
+    "QoSLivelinessChangedInfo", "QoSLivelinessLostInfo", "QoSMessageLostInfo", "QoSOfferedDeadlineMissedInfo",
+    "QoSOfferedIncompatibleQoSInfo", "QoSPublisherEventType", "QoSRequestedDeadlineMissedInfo",
+    "QoSRequestedIncompatibleQoSInfo", "QoSSubscriptionEventType", "SubscriptionEventCallbacks",
+    "UnsupportedEventTypeError",
+]
+
+
+class UnsupportedEventTypeError(Exception):
+    """An event type the middleware does not support (aiorobot supports all it lists; never raised)."""
+
+
+class rmw_qos_policy_kind_t(enum.IntEnum):  # noqa: N801  (rclpy's pybind11 enum name)
+    """The type of ``last_policy_kind`` in rclpy (values as ``QoSPolicyKind``'s)."""
+
+    RMW_QOS_POLICY_INVALID = 1 << 0
+    RMW_QOS_POLICY_DURABILITY = 1 << 1
+    RMW_QOS_POLICY_DEADLINE = 1 << 2
+    RMW_QOS_POLICY_LIVELINESS = 1 << 3
+    RMW_QOS_POLICY_RELIABILITY = 1 << 4
+    RMW_QOS_POLICY_HISTORY = 1 << 5
+    RMW_QOS_POLICY_LIFESPAN = 1 << 6
+    RMW_QOS_POLICY_DEPTH = 1 << 7
+    RMW_QOS_POLICY_LIVELINESS_LEASE_DURATION = 1 << 8
+    RMW_QOS_POLICY_AVOID_ROS_NAMESPACE_CONVENTIONS = 1 << 9
+
+    def __str__(self) -> str:  # pybind11's enum str
+        return f"rmw_qos_policy_kind_t.{self.name}"
+
+    def __format__(self, spec: str) -> str:  # f-strings print the name too
+        return format(str(self), spec)
+
+
+def rclpy_status(status: Any) -> Any:
+    """``status`` as rclpy's callback gets it (``last_policy_kind`` as rclpy's enum)."""
+    if isinstance(status, QoSRequestedIncompatibleQoSInfo):
+        import dataclasses
+
+        return dataclasses.replace(status, last_policy_kind=rmw_qos_policy_kind_t(int(status.last_policy_kind)))
+    return status
+
+
+def _no_matched(matched: Callable[..., Any] | None, owner: str) -> None:
+    if matched is not None:
+        raise not_provided(f"rclpy.event_handler.{owner}(matched=...)")
+
+
+class SubscriptionEventCallbacks(_eh.SubscriptionEventCallbacks):
+    """rclpy's ``SubscriptionEventCallbacks`` (``matched`` is not provided)."""
+
+    def __init__(
+        self, *, deadline: Callable[..., Any] | None = None, incompatible_qos: Callable[..., Any] | None = None,
+        liveliness: Callable[..., Any] | None = None, message_lost: Callable[..., Any] | None = None,
+        incompatible_type: Callable[..., Any] | None = None, matched: Callable[..., Any] | None = None,
+        use_default_callbacks: bool = True,
+    ) -> None:
+        _no_matched(matched, "SubscriptionEventCallbacks")
+        super().__init__(
+            deadline=deadline, incompatible_qos=incompatible_qos, liveliness=liveliness, message_lost=message_lost,
+            incompatible_type=incompatible_type, use_default_callbacks=use_default_callbacks,
+        )
+        self.matched = None
+
+
+class PublisherEventCallbacks(_eh.PublisherEventCallbacks):
+    """rclpy's ``PublisherEventCallbacks`` (``matched`` is not provided)."""
+
+    def __init__(
+        self, *, deadline: Callable[..., Any] | None = None, liveliness: Callable[..., Any] | None = None,
+        incompatible_qos: Callable[..., Any] | None = None, incompatible_type: Callable[..., Any] | None = None,
+        matched: Callable[..., Any] | None = None, use_default_callbacks: bool = True,
+    ) -> None:
+        _no_matched(matched, "PublisherEventCallbacks")
+        super().__init__(
+            deadline=deadline, liveliness=liveliness, incompatible_qos=incompatible_qos,
+            incompatible_type=incompatible_type, use_default_callbacks=use_default_callbacks,
+        )
+        self.matched = None
+
+
+#: rclpy's deprecated name.
+QoSEventHandler = EventHandler
+
+__getattr__ = module_getattr(
+    __name__, "rclpy.event_handler", {"QoSSubscriptionMatchedInfo", "QoSPublisherMatchedInfo"},
+)
