@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import asyncio
 import collections
+import contextlib
 import os
 import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Coroutine
+from collections.abc import Callable, Coroutine, Iterator
 from typing import Any, TypeVar
 
 from .._ros_args import RosArgs, parse_ros_args
@@ -63,6 +64,9 @@ class Context:
         self._saved_handlers: dict[int, Any] = {}
         #: Ctrl-C arrived while the loop ran in this thread: the spin raises KeyboardInterrupt on its way out
         self._interrupted = False
+        #: spin loops (rclpy.spin, Executor.spin) running in the main thread: Ctrl-C between two
+        #: passes is raised by the loop, not wherever the main thread happens to be
+        self._main_spin_depth = 0
         #: the executor whose spin is running the loop (decides where plain callbacks run)
         self.executor: Any = None
         self.callbacks_done = 0
@@ -123,6 +127,30 @@ class Context:
         self._on_shutdown.append(callback)
 
     # -- running the loop ---------------------------------------------------------------
+
+    @contextlib.contextmanager
+    def spinning(self) -> Iterator[None]:
+        """Around a spin loop: a Ctrl-C between its passes ends it with KeyboardInterrupt, as rclpy's.
+
+        Without this the handler would raise wherever the main thread is between two passes
+        (inside a weakref callback or a ``__del__``, where Python ignores it and the program
+        runs on).
+        """
+        main = threading.current_thread() is threading.main_thread()
+        if main:
+            self._main_spin_depth += 1
+        try:
+            yield
+        finally:
+            if main:
+                self._main_spin_depth -= 1
+        self.raise_if_interrupted()
+
+    def raise_if_interrupted(self) -> None:
+        if self._interrupted and threading.current_thread() is threading.main_thread():
+            self._interrupted = False
+            self._close_if_idle()
+            raise KeyboardInterrupt
 
     def in_callback(self) -> bool:
         return bool(getattr(self._local, "depth", 0))
@@ -213,6 +241,7 @@ class Context:
 
         ``admissions`` caps how many program callbacks may start meanwhile (``spin_once``: 1).
         """
+        self.raise_if_interrupted()  # a Ctrl-C that came between two passes of a spin loop
         self.require_ok("spin")
         loop = self.loop
         assert loop is not None
@@ -400,7 +429,8 @@ class Context:
             loop, runtime = self.loop, self.runtime
             if loop is not None and runtime is not None and not loop.is_closed():
                 loop.call_soon_threadsafe(runtime.shutdown)
-                if loop.is_running() and self._spin_thread == threading.get_ident() and not self._interrupted:
+                spinning_here = loop.is_running() and self._spin_thread == threading.get_ident()
+                if (spinning_here or self._main_spin_depth > 0) and not self._interrupted:
                     # Raising here would leave the KeyboardInterrupt inside whichever task step runs
                     # ("Task exception was never retrieved"). Wake the spin instead: it raises
                     # KeyboardInterrupt from the spin call, where rclpy raises it. A callback that blocks

@@ -95,8 +95,9 @@ def spin(node: Any, executor: Any = None) -> None:
     executor = get_global_executor() if executor is None else executor
     try:
         executor.add_node(node)
-        while executor.context.ok():
-            executor.spin_once()
+        with executor.context.spinning():
+            while executor.context.ok():
+                executor.spin_once()
     finally:
         executor.remove_node(node)
 

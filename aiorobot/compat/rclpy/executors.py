@@ -117,14 +117,15 @@ class Executor:
         return fut
 
     def spin(self) -> None:
-        if type(self).spin_once is not Executor.spin_once:
-            # a custom executor: rclpy's spin calls its spin_once, which takes work with
-            # wait_for_ready_callbacks
+        with self._context.spinning():
+            if type(self).spin_once is not Executor.spin_once:
+                # a custom executor: rclpy's spin calls its spin_once, which takes work with
+                # wait_for_ready_callbacks
+                while self._context.ok() and not self._is_shutdown:
+                    self.spin_once()
+                return
             while self._context.ok() and not self._is_shutdown:
-                self.spin_once()
-            return
-        while self._context.ok() and not self._is_shutdown:
-            self._context.spin_until(self, lambda: self._is_shutdown, None, raise_on_shutdown=True)
+                self._context.spin_until(self, lambda: self._is_shutdown, None, raise_on_shutdown=True)
 
     def wait_for_ready_callbacks(
         self, timeout_sec: float | None = None, nodes: list[Any] | None = None,
@@ -140,6 +141,7 @@ class Executor:
         this waits.
         """
         ctx = self._context
+        ctx.raise_if_interrupted()
         if self._is_shutdown or not ctx.ok():
             raise ShutdownException()
         wanted = self._nodes if nodes is None else list(nodes)
