@@ -111,3 +111,16 @@ def test_an_rclpy_listener_and_client_use_native_nodes_in_another_process(router
     finally:
         native.stop()
     assert native.proc.returncode in (0, -signal.SIGINT), native.output
+
+
+def test_a_program_that_never_spins_still_publishes_to_other_processes(router):
+    """publisher_old_school.py publishes in a plain loop: rmw sends without spinning, so does zenoh here."""
+    native = Native(router, "Listener")
+    try:
+        native.wait_for("native ready")
+        talker = _rclpy(router, "examples_rclpy_minimal_publisher/publisher_old_school.py")
+        native.wait_for("native heard: Hello World: 2")
+        assert talker.stop() == 0, talker.output
+    finally:
+        native.stop()
+    assert "Traceback" not in talker.output
