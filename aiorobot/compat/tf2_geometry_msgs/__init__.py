@@ -6,29 +6,9 @@ Importing it registers the types with tf2_ros, as upstream, so ``buffer.transfor
 
 from __future__ import annotations
 
-from ._transforms import (
-    do_transform_point,
-    do_transform_polygon_stamped,
-    do_transform_pose,
-    do_transform_pose_stamped,
-    do_transform_pose_with_covariance_stamped,
-    do_transform_vector3,
-    from_msg_msg,
-    register,
-    to_msg_msg,
-    transform_covariance,
-)
+from . import _transforms
+from ._transforms import *  # noqa: F403 - the package is its do_transform_* functions
 
-__all__ = [
-    "do_transform_point",
-    "do_transform_polygon_stamped",
-    "do_transform_pose",
-    "do_transform_pose_stamped",
-    "do_transform_pose_with_covariance_stamped",
-    "do_transform_vector3",
-    "from_msg_msg",
-    "to_msg_msg",
-    "transform_covariance",
-]
+__all__ = list(_transforms.__all__)
 
-register()
+_transforms.register()
