@@ -167,7 +167,7 @@ class SerialMotorBridge(Node):
     def _on_disconnect(self, exc: BaseException) -> None:
         self.firmware_alive = False
         if self._shutting_down:
-            self.get_logger().info(f"{self.port} closed during shutdown: {exc}")
+            self.get_logger().debug(f"{self.port} closed during shutdown: {exc}")  # expected: the other end went first
             return
         self.get_logger().error(f"lost {self.port}: {exc}; reconnecting every {self.reconnect_period_sec} s")
 
