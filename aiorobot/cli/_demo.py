@@ -150,7 +150,7 @@ def _print_summary(s: object) -> None:
         ("CPU: main process / perception workers", f"{f['cpu_pct']:.0f} % / {f['workers_cpu_pct']:.0f} % of a core"),
     ]
     if f["localisation"] == "landmarks":
-        rows.insert(3, ("landmark fixes", str(f["landmark_fixes"])))
+        rows.insert(3, ("landmark fixes (with heading)", f"{f['landmark_fixes']} ({f.get('landmark_heading_fixes', 0)})"))
     if f["record"]:
         rows.append(("recorded to", f["record"]))
     for name, value in rows:

@@ -29,7 +29,9 @@ CONTROL_HZ = 50.0
 
 _TWIST_XY_YAW = [False] * 6 + [True, True, False, False, False, True] + [False] * 3
 _YAW_RATE = [False] * 11 + [True] + [False] * 3
-_POSITION_XY = [True, True] + [False] * 13
+#: landmark fixes: x, y, and yaw (measured by fixes from two or more markers; a one-marker fix's yaw
+#: carries a variance of 1e6, so it adds nothing)
+_POSE_XY_YAW = [True, True] + [False] * 3 + [True] + [False] * 9
 _PROCESS_NOISE = [1e-4, 1e-4, 0.06, 0.03, 0.03, 1e-4, 0.025, 0.025, 0.04, 0.01, 0.01, 0.02, 0.01, 0.01, 0.015]
 
 
@@ -71,7 +73,7 @@ def _ekf_parameters(world_frame: str, *, pose: bool, start: tuple[float, float, 
     if pose:
         x, y, yaw = start
         params.update({
-            "pose0": "/landmark_pose", "pose0_config": _POSITION_XY, "pose0_rejection_threshold": 5.0,
+            "pose0": "/landmark_pose", "pose0_config": _POSE_XY_YAW, "pose0_rejection_threshold": 5.0,
             "initial_state": [x, y, 0.0, 0.0, 0.0, yaw] + [0.0] * 9,
         })
     return params

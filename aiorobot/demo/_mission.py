@@ -85,6 +85,8 @@ class DemoSummary:
     perception_frames: int = 0
     perception_dropped: int = 0
     landmark_fixes: int = 0
+    #: of those, the fixes from two or more markers in one image, which measured the heading too
+    landmark_heading_fixes: int = 0
     #: CPU of the main process (its loops and threads) and of the perception workers, % of one core
     cpu_pct: float = 0.0
     workers_cpu_pct: float = 0.0
@@ -359,6 +361,7 @@ async def run_demo(
                 summary.perception_dropped = stats.dropped_queue
             if graph.landmark_fixes is not None:
                 summary.landmark_fixes = graph.landmark_fixes.fixes
+                summary.landmark_heading_fixes = graph.landmark_fixes.heading_fixes
             periods = probe.periods_ms(probe_from)
             if rtf > 0 and periods.size:
                 # sim-time periods: the wall period scaled by the real-time factor

@@ -20,7 +20,7 @@ from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, plan
 from ._amcl_node import AmclNode
 from ._geometry import pose_stamped
-from ._landmarks import LandmarkFixNode, base_pose_from_marker, map_from_marker
+from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
 from ._map_server import MapServer
 from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationServer
@@ -31,6 +31,7 @@ __all__ = [
     "AmclNode",
     "LandmarkFixNode",
     "base_pose_from_marker",
+    "base_pose_from_markers",
     "map_from_marker",
     "MapServer",
     "MappingNode",

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from .._node import Node
 
-__all__ = ["LandmarkFixNode", "base_pose_from_marker", "map_from_marker"]
+__all__ = ["LandmarkFixNode", "base_pose_from_marker", "base_pose_from_markers", "map_from_marker"]
 
 
 def map_from_marker(x: float, y: float, z: float, yaw: float) -> NDArray[np.float64]:
@@ -76,6 +76,37 @@ def base_pose_from_marker(
     return float(map_from_base[0, 3]), float(map_from_base[1, 3]), math.atan2(map_from_base[1, 0], map_from_base[0, 0])
 
 
+def base_pose_from_markers(
+    map_from_markers: list[NDArray[np.float64]],
+    optical_from_markers: list[NDArray[np.float64]],
+    base_from_optical: NDArray[np.float64],
+) -> tuple[float, float, float]:
+    """``(x, y, yaw)`` of the base in the map from two or more markers seen in one image.
+
+    Uses the markers' positions only (accurate to centimetres, where a small marker's
+    orientation is not): the 2-D rigid transform that best lays the markers' positions on the
+    base onto their places in the map, in the least-squares sense (Kabsch). Its heading is as
+    good as the markers are far apart.
+    """
+    if len(map_from_markers) != len(optical_from_markers) or len(map_from_markers) < 2:
+        raise ValueError(
+            f"base_pose_from_markers: expected two or more (map_from_marker, optical_from_marker) pairs, "
+            f"found {len(map_from_markers)} and {len(optical_from_markers)}"
+        )
+    c = np.asarray(base_from_optical, dtype=np.float64)
+    if c.shape != (4, 4):
+        raise ValueError(f"base_from_optical must have shape (4, 4), got shape {c.shape}")
+    in_map = np.array([np.asarray(a, dtype=np.float64)[:2, 3] for a in map_from_markers])
+    in_base = np.array([(c @ np.asarray(b, dtype=np.float64)[:, 3])[:2] for b in optical_from_markers])
+    pm, pb = in_map - in_map.mean(axis=0), in_base - in_base.mean(axis=0)
+    # the rotation taking base-frame offsets onto map-frame ones: atan2(sum of cross, sum of dot)
+    yaw = math.atan2(float(np.sum(pb[:, 0] * pm[:, 1] - pb[:, 1] * pm[:, 0])), float(np.sum(pb[:, 0] * pm[:, 0] + pb[:, 1] * pm[:, 1])))
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    mb = in_base.mean(axis=0)
+    mm = in_map.mean(axis=0)
+    return float(mm[0] - (cy * mb[0] - sy * mb[1])), float(mm[1] - (sy * mb[0] + cy * mb[1])), yaw
+
+
 class LandmarkFixNode(Node):
     """``/detections/markers`` (aiorobot_msgs/MarkerDetectionArray) -> ``/landmark_pose``.
 
@@ -84,10 +115,15 @@ class LandmarkFixNode(Node):
     ``map_frame`` (map), ``base_frame`` (base_link), ``max_range_m`` (4.0: farther markers are
     ignored), ``position_std_m`` (0.03 at 1 m, growing with the square of the range) and
     ``yaw_std_rad`` (0.05: the heading's uncertainty, whose effect on position grows with the
-    range). The heading of a fix is the current map -> base_link estimate's (tf at the image's
-    stamp; see :func:`base_pose_from_marker`), so give the fix's yaw no weight in the filter
-    (``pose0_config`` x and y only). One fix per marker seen; unknown ids, markers beyond range
-    and frames without a heading estimate yet are counted in ``ignored``.
+    range). An image with two or more known markers at least ``min_baseline_m`` (1.0) apart
+    gives one fix of the whole pose, heading included, from the markers' positions
+    (:func:`base_pose_from_markers`; yaw standard deviation = the position's times sqrt(2) over
+    the markers' spread). Otherwise each marker gives a fix of position only: its heading is the
+    current map -> base_link estimate's (tf at the image's stamp; see
+    :func:`base_pose_from_marker`) and carries a variance of 1e6, so a filter that fuses the
+    fix's yaw (``pose0_config`` x, y and yaw) takes heading only from the multi-marker fixes.
+    Unknown ids, markers beyond range and frames without a heading estimate yet are counted in
+    ``ignored``; ``heading_fixes`` counts the fixes that measured the heading.
     """
 
     def __init__(self, node_name: str = "landmark_fixes", **kwargs: Any) -> None:
@@ -106,8 +142,10 @@ class LandmarkFixNode(Node):
         self.max_range_m = float(d("max_range_m", 4.0).value)
         self.position_std_m = float(d("position_std_m", 0.03).value)
         self.yaw_std_rad = float(d("yaw_std_rad", 0.05).value)
+        self.min_baseline_m = float(d("min_baseline_m", 1.0).value)
         self.landmarks = {lm.id: map_from_marker(lm.x, lm.y, lm.z, lm.yaw) for lm in world.landmarks}
         self.fixes = 0
+        self.heading_fixes = 0
         self.ignored = 0
         self.buffer = Buffer()
         self.listener = TransformListener(self.buffer, self)
@@ -117,7 +155,8 @@ class LandmarkFixNode(Node):
         self._base_from_optical: dict[str, NDArray[np.float64]] = {}
 
     def __repr__(self) -> str:
-        return f"<LandmarkFixNode landmarks={len(self.landmarks)} fixes={self.fixes} ignored={self.ignored}>"
+        return (f"<LandmarkFixNode landmarks={len(self.landmarks)} fixes={self.fixes} "
+                f"heading_fixes={self.heading_fixes} ignored={self.ignored}>")
 
     def _mount(self, frame: str) -> NDArray[np.float64] | None:
         from aiorobot import Time
@@ -150,14 +189,13 @@ class LandmarkFixNode(Node):
     def on_markers(self, msg: Any) -> None:
         from aiorobot.tf import transform_from_pq
 
-        from ._geometry import yaw_quaternion
-
         if not msg.detections:
             return
         mount = self._mount(msg.header.frame_id)
         if mount is None:
             self.ignored += len(msg.detections)
             return
+        seen: list[tuple[NDArray[np.float64], NDArray[np.float64], float]] = []
         for det in msg.detections:
             where = self.landmarks.get(int(det.marker_id))
             p, q = det.pose.position, det.pose.orientation
@@ -165,22 +203,38 @@ class LandmarkFixNode(Node):
             if where is None or not distance <= self.max_range_m:
                 self.ignored += 1
                 continue
-            heading = self._heading(msg.header.stamp)
-            if heading is None:
-                self.ignored += 1
-                continue
-            x, y, yaw = base_pose_from_marker(where, transform_from_pq((p.x, p.y, p.z), (q.x, q.y, q.z, q.w)), mount,
-                                              yaw=heading)
-            out = self._msg_type()
-            out.header.stamp = msg.header.stamp
-            out.header.frame_id = self.map_frame
-            out.pose.pose.position.x, out.pose.pose.position.y = x, y
-            out.pose.pose.orientation = yaw_quaternion(yaw)
+            seen.append((where, transform_from_pq((p.x, p.y, p.z), (q.x, q.y, q.z, q.w)), distance))
+        if len(seen) >= 2:
+            places = np.array([w[:2, 3] for w, _, _ in seen])
+            spread = float(np.max(np.linalg.norm(places[:, None, :] - places[None, :, :], axis=2)))
+            if spread >= self.min_baseline_m:
+                x, y, yaw = base_pose_from_markers([w for w, _, _ in seen], [o for _, o, _ in seen], mount)
+                far = max(dist for _, _, dist in seen)
+                var_xy = (self.position_std_m * max(far, 1.0) ** 2) ** 2 / len(seen)
+                self._publish(msg.header.stamp, x, y, yaw, var_xy, 2.0 * var_xy / spread ** 2)
+                self.heading_fixes += 1
+                return
+        heading = self._heading(msg.header.stamp)
+        if heading is None:
+            self.ignored += len(seen)
+            return
+        for where, optical_from_marker, distance in seen:
+            x, y, yaw = base_pose_from_marker(where, optical_from_marker, mount, yaw=heading)
             var_xy = (self.position_std_m * max(distance, 1.0) ** 2) ** 2 + (distance * self.yaw_std_rad) ** 2
-            cov = np.zeros(36)
-            cov[0] = cov[7] = var_xy
-            cov[14] = cov[21] = cov[28] = 1e6
-            cov[35] = self.yaw_std_rad ** 2
-            out.pose.covariance = cov
-            self.pub.publish(out)
-            self.fixes += 1
+            self._publish(msg.header.stamp, x, y, yaw, var_xy, 1e6)
+
+    def _publish(self, stamp: Any, x: float, y: float, yaw: float, var_xy: float, var_yaw: float) -> None:
+        from ._geometry import yaw_quaternion
+
+        out = self._msg_type()
+        out.header.stamp = stamp
+        out.header.frame_id = self.map_frame
+        out.pose.pose.position.x, out.pose.pose.position.y = x, y
+        out.pose.pose.orientation = yaw_quaternion(yaw)
+        cov = np.zeros(36)
+        cov[0] = cov[7] = var_xy
+        cov[14] = cov[21] = cov[28] = 1e6
+        cov[35] = var_yaw
+        out.pose.covariance = cov
+        self.pub.publish(out)
+        self.fixes += 1

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from aiorobot.nav import base_pose_from_marker, map_from_marker
+from aiorobot.nav import base_pose_from_marker, base_pose_from_markers, map_from_marker
 from aiorobot.perception import detect_markers
 from aiorobot.sim import CAMERA_XYZ, World
 from aiorobot.sim._camera import CameraModel, MarkerRenderer, camera_pose_matrix
@@ -61,3 +61,38 @@ def test_a_rendered_and_detected_marker_fixes_the_pose_within_a_few_centimetres(
 def test_bad_shapes_are_named() -> None:
     with pytest.raises(ValueError, match=r"optical_from_marker must have shape \(4, 4\), got shape \(3, 3\)"):
         base_pose_from_marker(np.eye(4), np.eye(3), np.eye(4))
+
+
+def _seen_from(pose: tuple[float, float, float], marker: np.ndarray) -> np.ndarray:
+    x, y, yaw = pose
+    map_from_optical = camera_pose_matrix(x + CAMERA_XYZ[0] * math.cos(yaw), y + CAMERA_XYZ[0] * math.sin(yaw),
+                                          CAMERA_XYZ[2], yaw)
+    return np.linalg.inv(map_from_optical) @ marker
+
+
+@pytest.mark.parametrize("pose", [(1.0, 0.0, 0.0), (0.5, 0.4, 0.3), (-0.2, -0.6, -0.25)])
+def test_two_markers_give_the_heading_from_their_positions_alone(pose: tuple[float, float, float]) -> None:
+    markers = [map_from_marker(3.0, -0.8, 0.25, math.pi), map_from_marker(3.0, 0.9, 0.25, math.pi)]
+    seen = [_seen_from(pose, m) for m in markers]
+    np.testing.assert_allclose(base_pose_from_markers(markers, seen, _base_from_optical()), pose, atol=1e-9)
+    # the markers' orientations are not used: spin each seen marker about its own centre
+    spun = [s @ np.array([[0.0, -1.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0, 0, 0, 1.0]]) for s in seen]
+    np.testing.assert_allclose(base_pose_from_markers(markers, spun, _base_from_optical()), pose, atol=1e-9)
+
+
+def test_noisy_marker_positions_give_a_least_squares_heading() -> None:
+    rng = np.random.default_rng(3)
+    pose = (0.7, -0.2, 0.2)
+    markers = [map_from_marker(3.0, y, 0.25, math.pi) for y in (-1.5, -0.5, 0.5, 1.5)]
+    seen = []
+    for m in markers:
+        s = _seen_from(pose, m)
+        s[:3, 3] += rng.normal(0.0, 0.01, 3)  # 1 cm of position noise per marker
+        seen.append(s)
+    x, y, yaw = base_pose_from_markers(markers, seen, _base_from_optical())
+    assert math.hypot(x - pose[0], y - pose[1]) < 0.03 and abs(yaw - pose[2]) < 0.02
+
+
+def test_one_marker_is_not_enough_for_the_heading() -> None:
+    with pytest.raises(ValueError, match="expected two or more"):
+        base_pose_from_markers([np.eye(4)], [np.eye(4)], np.eye(4))
