@@ -1,21 +1,6 @@
 """``tf2_ros.buffer_interface``."""
 
-from ._interface import (
-    BufferInterface,
-    ConvertRegistration,
-    NotImplementedException,
-    Stamped,
-    TransformRegistration,
-    TypeException,
-    convert,
-)
+from . import _interface
+from ._interface import *  # noqa: F403 - upstream's module of these names
 
-__all__ = [
-    "BufferInterface",
-    "ConvertRegistration",
-    "NotImplementedException",
-    "Stamped",
-    "TransformRegistration",
-    "TypeException",
-    "convert",
-]
+__all__ = list(_interface.__all__)
