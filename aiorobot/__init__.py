@@ -48,9 +48,11 @@ _EXPORTS = {
     "QoSOfferedDeadlineMissedInfo": "_event_handler",
     "QoSOfferedIncompatibleQoSInfo": "_event_handler",
     "QoSPublisherEventType": "_event_handler",
+    "QoSPublisherMatchedInfo": "_event_handler",
     "QoSRequestedDeadlineMissedInfo": "_event_handler",
     "QoSRequestedIncompatibleQoSInfo": "_event_handler",
     "QoSSubscriptionEventType": "_event_handler",
+    "QoSSubscriptionMatchedInfo": "_event_handler",
     "SubscriptionEventCallbacks": "_event_handler",
     "LivelinessPolicy": "_qos",
     "QoSPolicyKind": "_qos",
@@ -171,9 +173,11 @@ __all__ = [
     "QoSPresetProfiles",
     "QoSProfile",
     "QoSPublisherEventType",
+    "QoSPublisherMatchedInfo",
     "QoSRequestedDeadlineMissedInfo",
     "QoSRequestedIncompatibleQoSInfo",
     "QoSSubscriptionEventType",
+    "QoSSubscriptionMatchedInfo",
     "Rate",
     "ReentrantCallbackGroup",
     "ReliabilityPolicy",
@@ -212,7 +216,7 @@ if TYPE_CHECKING:
     from ._logging import NodeLogger, setup_logging
     from ._node import Node
     from ._parameters import FloatingPointRange, IntegerRange, Parameter, ParameterDescriptor, ParameterType, SetParametersResult
-    from ._event_handler import EventHandler, IncompatibleTypeInfo, PublisherEventCallbacks, QoSLivelinessChangedInfo, QoSLivelinessLostInfo, QoSMessageLostInfo, QoSOfferedDeadlineMissedInfo, QoSOfferedIncompatibleQoSInfo, QoSPublisherEventType, QoSRequestedDeadlineMissedInfo, QoSRequestedIncompatibleQoSInfo, QoSSubscriptionEventType, SubscriptionEventCallbacks
+    from ._event_handler import EventHandler, IncompatibleTypeInfo, PublisherEventCallbacks, QoSLivelinessChangedInfo, QoSLivelinessLostInfo, QoSMessageLostInfo, QoSOfferedDeadlineMissedInfo, QoSOfferedIncompatibleQoSInfo, QoSPublisherEventType, QoSPublisherMatchedInfo, QoSRequestedDeadlineMissedInfo, QoSRequestedIncompatibleQoSInfo, QoSSubscriptionEventType, QoSSubscriptionMatchedInfo, SubscriptionEventCallbacks
     from ._pubsub import MessageInfo, MessageStream, Publisher, Subscription
     from ._qos import LivelinessPolicy, QoSPolicyKind, qos_policy_name_from_kind
     from ._qos import DurabilityPolicy, HistoryPolicy, QoSPresetProfiles, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data, qos_profile_system_default

@@ -1,5 +1,9 @@
 """The in-process bus: topics, endpoint matching by type and QoS, transient-local history.
 
+Matching raises the QoS events of the endpoints concerned: ``incompatible_qos`` /
+``incompatible_type`` for a pair that does not connect, ``matched`` (in
+``Publisher._set_targets``) for each connection made or broken.
+
 The bus is shared by both loops of a runtime, so registration happens under a
 lock; the publish path reads an immutable tuple of matched subscriptions that
 the bus replaces whenever the matching changes, so it takes no lock.
@@ -162,14 +166,14 @@ class Bus:
             if isinstance(endpoint, Publisher):
                 if endpoint in topic.publishers:
                     topic.publishers.remove(endpoint)
-                endpoint._set_targets(())
+                endpoint._set_targets((), leaving=endpoint)
             elif endpoint in topic.subscriptions:
                 topic.subscriptions.remove(endpoint)  # type: ignore[arg-type]
             topic.incompatible = [
                 (p, s, r) for p, s, r in topic.incompatible if p is not endpoint and s is not endpoint
             ]
             for pub in topic.publishers:
-                self._retarget(topic, pub)
+                self._retarget(topic, pub, leaving=endpoint)
             if not topic.publishers and not topic.subscriptions:
                 del self._topics[topic.name]
         if self.transport is not None:
@@ -194,9 +198,9 @@ class Bus:
         for watcher in self._watchers:
             watcher(endpoint)
 
-    def _retarget(self, topic: _Topic, pub: Publisher) -> None:
+    def _retarget(self, topic: _Topic, pub: Publisher, *, leaving: Endpoint | None = None) -> None:
         bad = {id(s) for p, s, _ in topic.incompatible if p is pub}
-        pub._set_targets(tuple(s for s in topic.subscriptions if id(s) not in bad))
+        pub._set_targets(tuple(s for s in topic.subscriptions if id(s) not in bad), leaving=leaving)
 
     @staticmethod
     def _replay(pub: Publisher, sub: Sub) -> None:

@@ -1,5 +1,5 @@
 """QoS events, as rclpy's ``rclpy.event_handler``: deadline missed, liveliness, incompatible QoS
-and type, message lost.
+and type, message lost, matched.
 
 ``create_publisher(..., event_callbacks=PublisherEventCallbacks(deadline=cb))`` and
 ``create_subscription(..., event_callbacks=SubscriptionEventCallbacks(...))`` register
@@ -23,6 +23,11 @@ What produces the events, in process:
   check that logs (or, under ``strict_qos``, refuses) a pair that does not connect, with
   ``last_policy_kind`` naming the policy.
 - ``message_lost``: a message a full KEEP_LAST queue dropped before the callback took it.
+- ``matched``: the bus connected or disconnected a peer endpoint (a compatible subscription
+  for a publisher, a compatible publisher for a subscription; in process or, through a
+  transport, remote). ``total_count`` counts connections ever made and ``current_count``
+  those now, as rmw's ``rmw_matched_status_t``; an endpoint's own destruction or its node's
+  removal does not report to itself.
 
 Deadlines and leases are measured on the entity's node clock (sim time under
 ``use_sim_time``), and their watchers run on the loop of the node that owns the entity;
@@ -54,9 +59,11 @@ __all__ = [
     "QoSOfferedDeadlineMissedInfo",
     "QoSOfferedIncompatibleQoSInfo",
     "QoSPublisherEventType",
+    "QoSPublisherMatchedInfo",
     "QoSRequestedDeadlineMissedInfo",
     "QoSRequestedIncompatibleQoSInfo",
     "QoSSubscriptionEventType",
+    "QoSSubscriptionMatchedInfo",
     "SubscriptionEventCallbacks",
 ]
 
@@ -124,23 +131,43 @@ class IncompatibleTypeInfo:
     total_count_change: int = 0
 
 
+@dataclass(frozen=True, slots=True)
+class QoSPublisherMatchedInfo:
+    """Peer endpoints connected to or disconnected from this one (rmw's ``rmw_matched_status_t``).
+
+    ``total_count``: connections ever made; ``current_count``: connected now; each
+    ``*_change``: the change since the callback last ran.
+    """
+
+    total_count: int = 0
+    total_count_change: int = 0
+    current_count: int = 0
+    current_count_change: int = 0
+
+
+#: rclpy's alias: subscriptions get the same status type.
+QoSSubscriptionMatchedInfo = QoSPublisherMatchedInfo
+
+
 class QoSPublisherEventType(enum.IntEnum):
-    """rcl's ``rcl_publisher_event_type_t`` values (``MATCHED`` is not produced)."""
+    """rcl's ``rcl_publisher_event_type_t`` values."""
 
     RCL_PUBLISHER_OFFERED_DEADLINE_MISSED = 0
     RCL_PUBLISHER_LIVELINESS_LOST = 1
     RCL_PUBLISHER_OFFERED_INCOMPATIBLE_QOS = 2
     RCL_PUBLISHER_INCOMPATIBLE_TYPE = 3
+    RCL_PUBLISHER_MATCHED = 4
 
 
 class QoSSubscriptionEventType(enum.IntEnum):
-    """rcl's ``rcl_subscription_event_type_t`` values (``MATCHED`` is not produced)."""
+    """rcl's ``rcl_subscription_event_type_t`` values."""
 
     RCL_SUBSCRIPTION_REQUESTED_DEADLINE_MISSED = 0
     RCL_SUBSCRIPTION_LIVELINESS_CHANGED = 1
     RCL_SUBSCRIPTION_REQUESTED_INCOMPATIBLE_QOS = 2
     RCL_SUBSCRIPTION_MESSAGE_LOST = 3
     RCL_SUBSCRIPTION_INCOMPATIBLE_TYPE = 4
+    RCL_SUBSCRIPTION_MATCHED = 5
 
 
 # event name -> (event type, status type)
@@ -149,6 +176,7 @@ _PUBLISHER_EVENTS: dict[str, tuple[enum.IntEnum, type]] = {
     "liveliness": (QoSPublisherEventType.RCL_PUBLISHER_LIVELINESS_LOST, QoSLivelinessLostInfo),
     "incompatible_qos": (QoSPublisherEventType.RCL_PUBLISHER_OFFERED_INCOMPATIBLE_QOS, QoSOfferedIncompatibleQoSInfo),
     "incompatible_type": (QoSPublisherEventType.RCL_PUBLISHER_INCOMPATIBLE_TYPE, IncompatibleTypeInfo),
+    "matched": (QoSPublisherEventType.RCL_PUBLISHER_MATCHED, QoSPublisherMatchedInfo),
 }
 _SUBSCRIPTION_EVENTS: dict[str, tuple[enum.IntEnum, type]] = {
     "deadline": (QoSSubscriptionEventType.RCL_SUBSCRIPTION_REQUESTED_DEADLINE_MISSED, QoSRequestedDeadlineMissedInfo),
@@ -159,6 +187,7 @@ _SUBSCRIPTION_EVENTS: dict[str, tuple[enum.IntEnum, type]] = {
     "liveliness": (QoSSubscriptionEventType.RCL_SUBSCRIPTION_LIVELINESS_CHANGED, QoSLivelinessChangedInfo),
     "message_lost": (QoSSubscriptionEventType.RCL_SUBSCRIPTION_MESSAGE_LOST, QoSMessageLostInfo),
     "incompatible_type": (QoSSubscriptionEventType.RCL_SUBSCRIPTION_INCOMPATIBLE_TYPE, IncompatibleTypeInfo),
+    "matched": (QoSSubscriptionEventType.RCL_SUBSCRIPTION_MATCHED, QoSSubscriptionMatchedInfo),
 }
 
 
@@ -188,6 +217,7 @@ class EventHandler:
         self._changes = [0] * len(self._counts)
         self._policy = QoSPolicyKind.INVALID
         self._pending = False
+        self._task: asyncio.Task[None] | None = None
 
     def __repr__(self) -> str:
         return f"<EventHandler {self.event_type.name} of {self._parent!r}>"
@@ -205,9 +235,11 @@ class EventHandler:
         if policy is not None:
             self._policy = policy
         node: Node = self._parent.node
+        if self._pending and self._task is not None and self._task.done():
+            self._pending = False  # its delivery was cancelled before it ran (its node stopped)
         if not self._pending and node._loop is not None:
             self._pending = True
-            node._create_task(self._deliver(), name=f"event {self.event_type.name} {self._parent.topic_name}")
+            self._task = node._create_task(self._deliver(), name=f"event {self.event_type.name} {self._parent.topic_name}")
 
     def take_event(self) -> Any:
         """The status now (counts, and changes since the last take, which this resets)."""
@@ -232,6 +264,8 @@ class EventHandler:
 def _count_fields(info_type: type) -> tuple[str, ...]:
     if info_type is QoSLivelinessChangedInfo:
         return ("alive_count", "not_alive_count")
+    if info_type is QoSPublisherMatchedInfo:
+        return ("total_count", "current_count")
     return ("total_count",)
 
 
@@ -265,9 +299,9 @@ class _EventCallbacks:
 class SubscriptionEventCallbacks(_EventCallbacks):
     """The QoS event callbacks of a subscription (rclpy's), for ``create_subscription(event_callbacks=)``.
 
-    rclpy difference: no ``matched`` callback, and no default incompatible-QoS and
-    incompatible-type handlers (``use_default_callbacks`` is accepted and has no effect): the
-    runtime already logs one warning naming both endpoints of a pair that does not connect.
+    rclpy difference: no default incompatible-QoS and incompatible-type handlers
+    (``use_default_callbacks`` is accepted and has no effect): the runtime already logs one
+    warning naming both endpoints of a pair that does not connect.
     """
 
     _events = _SUBSCRIPTION_EVENTS
@@ -280,20 +314,21 @@ class SubscriptionEventCallbacks(_EventCallbacks):
         liveliness: Callable[[QoSLivelinessChangedInfo], Any] | None = None,
         message_lost: Callable[[QoSMessageLostInfo], Any] | None = None,
         incompatible_type: Callable[[IncompatibleTypeInfo], Any] | None = None,
+        matched: Callable[[QoSSubscriptionMatchedInfo], Any] | None = None,
         use_default_callbacks: bool = True,
     ) -> None:
         super().__init__(
             use_default_callbacks, deadline=deadline, incompatible_qos=incompatible_qos, liveliness=liveliness,
-            message_lost=message_lost, incompatible_type=incompatible_type,
+            message_lost=message_lost, incompatible_type=incompatible_type, matched=matched,
         )
 
 
 class PublisherEventCallbacks(_EventCallbacks):
     """The QoS event callbacks of a publisher (rclpy's), for ``create_publisher(event_callbacks=)``.
 
-    rclpy difference: no ``matched`` callback, and no default incompatible-QoS and
-    incompatible-type handlers (``use_default_callbacks`` is accepted and has no effect): the
-    runtime already logs one warning naming both endpoints of a pair that does not connect.
+    rclpy difference: no default incompatible-QoS and incompatible-type handlers
+    (``use_default_callbacks`` is accepted and has no effect): the runtime already logs one
+    warning naming both endpoints of a pair that does not connect.
     """
 
     _events = _PUBLISHER_EVENTS
@@ -305,11 +340,12 @@ class PublisherEventCallbacks(_EventCallbacks):
         liveliness: Callable[[QoSLivelinessLostInfo], Any] | None = None,
         incompatible_qos: Callable[[QoSOfferedIncompatibleQoSInfo], Any] | None = None,
         incompatible_type: Callable[[IncompatibleTypeInfo], Any] | None = None,
+        matched: Callable[[QoSPublisherMatchedInfo], Any] | None = None,
         use_default_callbacks: bool = True,
     ) -> None:
         super().__init__(
             use_default_callbacks, deadline=deadline, liveliness=liveliness, incompatible_qos=incompatible_qos,
-            incompatible_type=incompatible_type,
+            incompatible_type=incompatible_type, matched=matched,
         )
 
 

@@ -161,8 +161,10 @@ class Publisher(Endpoint, Generic[M]):
             del self.publish  # (never through __dict__: that would slow every attribute of this object)
         self._watched = watched
 
-    def _set_targets(self, subs: tuple[Subscription | Tap, ...]) -> None:
-        """Install the matched subscriptions (called by the bus under its lock)."""
+    def _set_targets(self, subs: tuple[Subscription | Tap, ...], *, leaving: Endpoint | None = None) -> None:
+        """Install the matched subscriptions (called by the bus under its lock); ``leaving``: the
+        endpoint whose removal this is, which gets no ``matched`` event of its own."""
+        self._report_matched(subs, leaving)
         before = {id(s): s for s in self._subs if isinstance(s, Subscription)}
         after = {id(s): s for s in subs if isinstance(s, Subscription)}
         for key, sub in before.items():
@@ -190,6 +192,26 @@ class Publisher(Endpoint, Generic[M]):
         self._same_loop = tuple(same)
         self._other_loops = tuple((loop, tuple(group)) for loop, group in other.items())
         self._taps = tuple(taps)
+
+    def _report_matched(self, subs: tuple[Subscription | Tap, ...], leaving: Endpoint | None) -> None:
+        """Count the connections ``subs`` makes and breaks on this publisher's ``matched`` handler and
+        on those of the subscriptions concerned (a transport's hidden endpoints are nobody's peers)."""
+        old = {id(s): s for s in self._subs if not getattr(s, "hidden", False)}
+        new = {id(s): s for s in subs if not getattr(s, "hidden", False)}
+        gained = [s for key, s in new.items() if key not in old]
+        lost = [s for key, s in old.items() if key not in new]
+        if not gained and not lost:
+            return
+        handler = self._events.get("matched")
+        if handler is not None and self is not leaving:
+            handler._fire(len(gained), len(gained) - len(lost))
+        if getattr(self, "hidden", False):
+            return
+        for sub, deltas in [*((s, (1, 1)) for s in gained), *((s, (0, -1)) for s in lost)]:
+            if isinstance(sub, Subscription) and sub is not leaving:
+                sub_handler = sub._events.get("matched")
+                if sub_handler is not None:
+                    sub_handler._fire(*deltas)
 
     def publish(self, msg: M) -> None:
         """Hand a copy of ``msg`` (large arrays shared read-only) to every matched subscription.

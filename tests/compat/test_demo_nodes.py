@@ -145,9 +145,21 @@ def test_introspection_disabled_by_default_publishes_nothing():
     assert "native event" not in program.output
 
 
-def test_matched_event_detect_fails_at_the_matched_event_import():
-    # aiorobot has no "matched" QoS events; the program stops, in one line, at the import that needs them
+def test_matched_event_detect_logs_each_connection_as_it_is_made_and_broken():
+    # the program's own comments give what MatchedEventDetectNode prints after each step under rclpy
     program = Program("demo_nodes_py/events/matched_event_detect.py")
-    assert program.finish() == 1
-    assert "matched_event_detect.py:17: aiorobot does not provide rclpy.event_handler.QoSPublisherMatchedInfo yet; see https://" in program.output
-    assert "Traceback" not in program.output
+    _ends_cleanly(program)
+    logged = [line.split("]: ", 1)[1] for line in program.lines if "]: " in line]
+    sub, pub = "connected subscription", "connected publisher"
+    assert logged == [
+        "Create a new subscription.", "First subscription is connected.",
+        "Create a new subscription.", f"The changed number of {sub} is 1 and current number of {sub} is 2",
+        "Destroy a subscription.", f"The changed number of {sub} is -1 and current number of {sub} is 1",
+        "Destroy a subscription.", "Last subscription is disconnected.",
+        "Create a new publisher.", "First publisher is connected.",
+        "Create a new publisher.", f"The changed number of {pub} is 1 and current number of {pub} is 2",
+        "Destroy a publisher.", f"The changed number of {pub} is -1 and current number of {pub} is 1",
+        "Destroy a publisher.", "Last publisher is disconnected.",
+    ], program.output
+    detector = [line for line in program.lines if "is connected." in line or "disconnected." in line]
+    assert all("[/matched_event_detection_node]" in line for line in detector), program.output

@@ -1,4 +1,5 @@
-"""QoS events as rclpy's event_handler: deadline, liveliness, lifespan, incompatible QoS/type, message lost.
+"""QoS events as rclpy's event_handler: deadline, liveliness, lifespan, incompatible QoS/type, message lost,
+matched.
 
 Cases restate rclpy test/test_qos_event.py and rcl test/rcl/test_events.cpp (named per test);
 deadlines and leases run on sim time, so nothing waits on the wall clock.
@@ -24,8 +25,10 @@ from aiorobot import (
     QoSOfferedIncompatibleQoSInfo,
     QoSPolicyKind,
     QoSProfile,
+    QoSPublisherMatchedInfo,
     QoSRequestedDeadlineMissedInfo,
     QoSRequestedIncompatibleQoSInfo,
+    QoSSubscriptionMatchedInfo,
     ReliabilityPolicy,
     SubscriptionEventCallbacks,
     qos_policy_name_from_kind,
@@ -56,6 +59,9 @@ async def test_publisher_constructor(runtime):
     publisher = node.create_publisher(Empty, TOPIC, 10, event_callbacks=callbacks)
     assert len(publisher.event_handlers) == 3
     node.destroy_publisher(publisher)
+    callbacks.matched = lambda info: None
+    publisher = node.create_publisher(Empty, TOPIC, 10, event_callbacks=callbacks)
+    assert [h.event_type.name for h in publisher.event_handlers][-1] == "RCL_PUBLISHER_MATCHED"
 
 
 async def test_subscription_constructor(runtime):
@@ -71,13 +77,16 @@ async def test_subscription_constructor(runtime):
     assert len(node.create_subscription(Empty, TOPIC, cb, 10, event_callbacks=callbacks).event_handlers) == 2
     callbacks.incompatible_qos = lambda info: None
     assert len(node.create_subscription(Empty, TOPIC, cb, 10, event_callbacks=callbacks).event_handlers) == 3
+    callbacks.matched = lambda info: None
+    subscription = node.create_subscription(Empty, TOPIC, cb, 10, event_callbacks=callbacks)
+    assert [h.event_type.name for h in subscription.event_handlers][-1] == "RCL_SUBSCRIPTION_MATCHED"
 
 
 def test_event_callbacks_take_keywords_only_and_callables():
     with pytest.raises(TypeError):
         SubscriptionEventCallbacks(lambda info: None)  # type: ignore[misc]
     with pytest.raises(TypeError):
-        PublisherEventCallbacks(matched=lambda info: None)  # type: ignore[call-arg]
+        PublisherEventCallbacks(lambda info: None)  # type: ignore[misc]
 
 
 async def test_event_callbacks_must_be_callable(runtime):
@@ -179,6 +188,154 @@ async def test_incompatible_type_is_reported_to_both_endpoints(runtime):
     await settle(runtime)
     assert pub_got == [IncompatibleTypeInfo(total_count=1, total_count_change=1)]
     assert sub_got == [IncompatibleTypeInfo(total_count=1, total_count_change=1)]
+
+
+def matched(total, total_change, current, current_change):
+    return QoSPublisherMatchedInfo(total_count=total, total_count_change=total_change,
+                                   current_count=current, current_count_change=current_change)
+
+
+async def test_call_publisher_rclpy_event_matched(runtime):
+    # rclpy test_qos_event.py::test_call_publisher_rclpy_event_matched: a subscription joins, then leaves
+    node = runtime.add_node(Node("TestQoSEvent"))
+    got, cb = recorder()
+    pub = node.create_publisher(Empty, TOPIC, 10, event_callbacks=PublisherEventCallbacks(matched=cb))
+    (handler,) = pub.event_handlers
+    assert handler.event_type.name == "RCL_PUBLISHER_MATCHED"
+    await settle(runtime)
+    assert got == []  # nothing matched yet: not ready
+    sub = node.create_subscription(Empty, TOPIC, lambda m: None, 10)
+    await settle(runtime)
+    assert got == [matched(1, 1, 1, 1)]
+    assert isinstance(got[0], QoSPublisherMatchedInfo)
+    sub.destroy()
+    await settle(runtime)
+    assert got[1:] == [matched(1, 0, 0, -1)]
+    assert handler.take_event() == matched(1, 0, 0, 0)  # taking again: no change since
+
+
+async def test_call_subscription_rclpy_event_matched_unmatched(runtime):
+    # rclpy test_qos_event.py::test_call_subscription_rclpy_event_matched_unmatched
+    node = runtime.add_node(Node("TestQoSEvent"))
+    got, cb = recorder()
+    sub = node.create_subscription(Empty, TOPIC, lambda m: None, 10,
+                                   event_callbacks=SubscriptionEventCallbacks(matched=cb))
+    assert sub.event_handlers[0].take_event() == QoSSubscriptionMatchedInfo(0, 0, 0, 0)
+    await settle(runtime)
+    assert got == []
+    pub = node.create_publisher(Empty, TOPIC, 10)
+    await settle(runtime)
+    assert got == [matched(1, 1, 1, 1)]
+    pub.destroy()
+    await settle(runtime)
+    assert got[1:] == [matched(1, 0, 0, -1)]
+
+
+async def test_matched_counts_follow_the_demo_sequence(runtime):
+    # demo_nodes_py events/matched_event_detect.py's steps: peers join and leave one at a time
+    node = runtime.add_node(Node("detect"))
+    peers = runtime.add_node(Node("peers"))
+    pub_got, pub_cb = recorder()
+    sub_got, sub_cb = recorder()
+    pub = node.create_publisher(String, "/a", 10, event_callbacks=PublisherEventCallbacks(matched=pub_cb))
+    node.create_subscription(String, "/b", lambda m: None, 10, event_callbacks=SubscriptionEventCallbacks(matched=sub_cb))
+    subs = []
+    for _ in range(2):
+        subs.append(peers.create_subscription(String, "/a", lambda m: None, 10))
+        await settle(runtime)
+    for sub in subs:
+        peers.destroy_subscription(sub)
+        await settle(runtime)
+    assert pub_got == [matched(1, 1, 1, 1), matched(2, 1, 2, 1), matched(2, 0, 1, -1), matched(2, 0, 0, -1)]
+    assert pub.get_subscription_count() == 0
+    pubs = []
+    for _ in range(2):
+        pubs.append(peers.create_publisher(String, "/b", 10))
+        await settle(runtime)
+    for p in pubs:
+        peers.destroy_publisher(p)
+        await settle(runtime)
+    assert sub_got == pub_got
+
+
+async def test_matched_events_coalesce_until_the_callback_runs(runtime):
+    node = runtime.add_node(Node("n"))
+    got, cb = recorder()
+    node.create_publisher(Empty, TOPIC, 10, event_callbacks=PublisherEventCallbacks(matched=cb))
+    first = node.create_subscription(Empty, TOPIC, lambda m: None, 10)
+    node.create_subscription(Empty, TOPIC, lambda m: None, 10)
+    first.destroy()  # no await between: one callback sees the net change
+    await settle(runtime)
+    assert got == [matched(2, 2, 1, 1)]
+
+
+async def test_an_incompatible_peer_does_not_match(runtime):
+    node = runtime.add_node(Node("n"))
+    pub_got, pub_cb = recorder()
+    sub_got, sub_cb = recorder()
+    node.create_publisher(Empty, TOPIC, QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT),
+                          event_callbacks=PublisherEventCallbacks(matched=pub_cb))
+    node.create_subscription(Empty, TOPIC, lambda m: None, QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE),
+                             event_callbacks=SubscriptionEventCallbacks(matched=sub_cb))
+    node.create_subscription(Int32, TOPIC, lambda m: None, 10, event_callbacks=SubscriptionEventCallbacks(matched=sub_cb))
+    await settle(runtime)
+    assert pub_got == [] and sub_got == []
+
+
+async def test_a_removed_node_unmatches_its_peers_and_reports_nothing_to_itself(runtime):
+    node = runtime.add_node(Node("stays"))
+    got, cb = recorder()
+    gone_got, gone_cb = recorder()
+    node.create_subscription(Empty, TOPIC, lambda m: None, 10, event_callbacks=SubscriptionEventCallbacks(matched=cb))
+    leaving = runtime.add_node(Node("leaves"))
+    leaving.create_publisher(Empty, TOPIC, 10, event_callbacks=PublisherEventCallbacks(matched=gone_cb))
+    await settle(runtime)
+    assert got == [matched(1, 1, 1, 1)] and gone_got == [matched(1, 1, 1, 1)]
+    runtime.remove_node(leaving)
+    await settle(runtime)
+    assert got[1:] == [matched(1, 0, 0, -1)]
+    assert gone_got == [matched(1, 1, 1, 1)]
+
+
+async def test_a_destroyed_endpoint_reports_nothing_to_itself(runtime):
+    node = runtime.add_node(Node("n"))
+    pub_got, pub_cb = recorder()
+    sub_got, sub_cb = recorder()
+    pub = node.create_publisher(Empty, TOPIC, 10, event_callbacks=PublisherEventCallbacks(matched=pub_cb))
+    sub = node.create_subscription(Empty, TOPIC, lambda m: None, 10,
+                                   event_callbacks=SubscriptionEventCallbacks(matched=sub_cb))
+    await settle(runtime)
+    node.destroy_publisher(pub)
+    await settle(runtime)
+    assert pub_got == [matched(1, 1, 1, 1)]
+    assert sub_got == [matched(1, 1, 1, 1), matched(1, 0, 0, -1)]
+    pub = node.create_publisher(Empty, TOPIC, 10, event_callbacks=PublisherEventCallbacks(matched=pub_cb))
+    await settle(runtime)
+    node.destroy_subscription(sub)
+    await settle(runtime)
+    assert pub_got[1:] == [matched(1, 1, 1, 1), matched(1, 0, 0, -1)]
+    assert sub_got[2:] == [matched(2, 1, 1, 1)]
+
+
+async def test_a_remote_endpoint_matches_and_unmatches_as_it_joins_and_leaves_the_bus(runtime):
+    # what the zenoh transport does for a remote subscription (tests/transport/test_peers.py runs it on
+    # zenoh): a Tap named after the remote node joins the bus, and leaves it when the peer goes; its
+    # hidden sender tap is nobody's peer
+    from aiorobot._pubsub import Tap
+
+    node = runtime.add_node(Node("n"))
+    got, cb = recorder()
+    pub = node.create_publisher(Empty, TOPIC, 10, event_callbacks=PublisherEventCallbacks(matched=cb))
+    sender = Tap(Empty, TOPIC, QoSProfile(depth=10), lambda m: None, owner="<zenoh>")
+    sender.hidden = True
+    runtime._bus.add_subscription(sender)
+    remote = Tap(Empty, TOPIC, QoSProfile(depth=10), lambda m: None, owner="/remote_node")
+    runtime._bus.add_subscription(remote)
+    await settle(runtime)
+    assert got == [matched(1, 1, 1, 1)] and pub.get_subscription_count() == 1
+    runtime._bus.remove(remote)
+    await settle(runtime)
+    assert got[1:] == [matched(1, 0, 0, -1)]
 
 
 class Pair:

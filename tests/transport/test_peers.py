@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from aiorobot import Node
+from aiorobot import Node, PublisherEventCallbacks, SubscriptionEventCallbacks
 from aiorobot.msgs.std_msgs import String
 
 from ._helpers import peer_runtime, spawn, wait_until
@@ -57,3 +57,21 @@ async def test_domains_do_not_see_each_other(router_port: int) -> None:
             assert seen_other == []
     finally:
         await child.stop()
+
+
+async def test_remote_endpoints_match_local_ones_and_unmatch_when_their_peer_leaves(router_port: int) -> None:
+    async with peer_runtime(router_port) as rt:
+        node = rt.add_node(Node("detect"))
+        pub_got: list[tuple[int, int]] = []
+        sub_got: list[tuple[int, int]] = []
+        node.create_publisher(String, "/matched_a", 10, event_callbacks=PublisherEventCallbacks(
+            matched=lambda info: pub_got.append((info.total_count, info.current_count))))
+        node.create_subscription(String, "/matched_b", lambda m: None, 10, event_callbacks=SubscriptionEventCallbacks(
+            matched=lambda info: sub_got.append((info.total_count, info.current_count))))
+        async with peer_runtime(router_port) as other:
+            remote = other.add_node(Node("remote"))
+            remote.create_subscription(String, "/matched_a", lambda m: None, 10)
+            remote.create_publisher(String, "/matched_b", 10)
+            await wait_until(lambda: pub_got[-1:] == [(1, 1)] and sub_got[-1:] == [(1, 1)])
+        await wait_until(lambda: pub_got[-1] == (1, 0) and sub_got[-1] == (1, 0))  # the peer left
+        assert pub_got == [(1, 1), (1, 0)] and sub_got == [(1, 1), (1, 0)]

@@ -6,8 +6,7 @@ and an incompatible-QoS status's ``last_policy_kind`` prints as rclpy's does
 (``rmw_qos_policy_kind_t.RMW_QOS_POLICY_DURABILITY``) while staying an int that
 ``qos_policy_name_from_kind`` takes.
 
-rclpy differences: no ``matched`` events (passing ``matched=`` raises
-``NotProvidedError``), and no default incompatible-QoS/type callbacks: the runtime logs one
+rclpy difference: no default incompatible-QoS/type callbacks: the runtime logs one
 warning naming both endpoints of a pair that does not connect (docs/rclpy-differences.md).
 """
 
@@ -27,17 +26,19 @@ from ..._event_handler import (
     QoSOfferedDeadlineMissedInfo,
     QoSOfferedIncompatibleQoSInfo,
     QoSPublisherEventType,
+    QoSPublisherMatchedInfo,
     QoSRequestedDeadlineMissedInfo,
     QoSRequestedIncompatibleQoSInfo,
     QoSSubscriptionEventType,
+    QoSSubscriptionMatchedInfo,
 )
-from .._missing import module_getattr, not_provided
 
 __all__ = [
     "EventHandler", "IncompatibleTypeInfo", "PublisherEventCallbacks", "QoSEventHandler",
     "QoSLivelinessChangedInfo", "QoSLivelinessLostInfo", "QoSMessageLostInfo", "QoSOfferedDeadlineMissedInfo",
-    "QoSOfferedIncompatibleQoSInfo", "QoSPublisherEventType", "QoSRequestedDeadlineMissedInfo",
-    "QoSRequestedIncompatibleQoSInfo", "QoSSubscriptionEventType", "SubscriptionEventCallbacks",
+    "QoSOfferedIncompatibleQoSInfo", "QoSPublisherEventType", "QoSPublisherMatchedInfo",
+    "QoSRequestedDeadlineMissedInfo", "QoSRequestedIncompatibleQoSInfo", "QoSSubscriptionEventType",
+    "QoSSubscriptionMatchedInfo", "SubscriptionEventCallbacks",
     "UnsupportedEventTypeError",
 ]
 
@@ -76,13 +77,8 @@ def rclpy_status(status: Any) -> Any:
     return status
 
 
-def _no_matched(matched: Callable[..., Any] | None, owner: str) -> None:
-    if matched is not None:
-        raise not_provided(f"rclpy.event_handler.{owner}(matched=...)")
-
-
 class SubscriptionEventCallbacks(_eh.SubscriptionEventCallbacks):
-    """rclpy's ``SubscriptionEventCallbacks`` (``matched`` is not provided)."""
+    """rclpy's ``SubscriptionEventCallbacks``."""
 
     def __init__(
         self, *, deadline: Callable[..., Any] | None = None, incompatible_qos: Callable[..., Any] | None = None,
@@ -90,33 +86,26 @@ class SubscriptionEventCallbacks(_eh.SubscriptionEventCallbacks):
         incompatible_type: Callable[..., Any] | None = None, matched: Callable[..., Any] | None = None,
         use_default_callbacks: bool = True,
     ) -> None:
-        _no_matched(matched, "SubscriptionEventCallbacks")
         super().__init__(
             deadline=deadline, incompatible_qos=incompatible_qos, liveliness=liveliness, message_lost=message_lost,
-            incompatible_type=incompatible_type, use_default_callbacks=use_default_callbacks,
+            incompatible_type=incompatible_type, matched=matched, use_default_callbacks=use_default_callbacks,
         )
-        self.matched = None
 
 
 class PublisherEventCallbacks(_eh.PublisherEventCallbacks):
-    """rclpy's ``PublisherEventCallbacks`` (``matched`` is not provided)."""
+    """rclpy's ``PublisherEventCallbacks``."""
 
     def __init__(
         self, *, deadline: Callable[..., Any] | None = None, liveliness: Callable[..., Any] | None = None,
         incompatible_qos: Callable[..., Any] | None = None, incompatible_type: Callable[..., Any] | None = None,
         matched: Callable[..., Any] | None = None, use_default_callbacks: bool = True,
     ) -> None:
-        _no_matched(matched, "PublisherEventCallbacks")
         super().__init__(
             deadline=deadline, liveliness=liveliness, incompatible_qos=incompatible_qos,
-            incompatible_type=incompatible_type, use_default_callbacks=use_default_callbacks,
+            incompatible_type=incompatible_type, matched=matched, use_default_callbacks=use_default_callbacks,
         )
-        self.matched = None
 
 
 #: rclpy's deprecated name.
 QoSEventHandler = EventHandler
 
-__getattr__ = module_getattr(
-    __name__, "rclpy.event_handler", {"QoSSubscriptionMatchedInfo", "QoSPublisherMatchedInfo"},
-)
