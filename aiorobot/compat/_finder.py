@@ -30,7 +30,7 @@ _ALIASES = {
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(
     {
-        "rclpy.waitable", "rclpy.wait_for_message", "rclpy.type_support",
+        "rclpy.waitable", "rclpy.type_support",
         "rclpy.topic_endpoint_info", "rclpy.parameter_service",
         "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",

@@ -81,3 +81,30 @@ def test_spin_once_runs_one_callback_per_call_as_rclpy(tmp_path):
     counts = [int(line.rsplit(":", 1)[1]) for line in program.lines if line.startswith("after spin_once:")]
     assert counts == [1, 2, 3, 4, 5], program.output
     assert "nothing left: ['0', '1', '2', '3', '4']" in program.output
+
+
+WAIT_FOR_MESSAGE = '''
+import rclpy
+from rclpy.wait_for_message import wait_for_message
+from std_msgs.msg import String
+
+rclpy.init()
+node = rclpy.create_node("waiter")
+heard = []
+node.create_subscription(String, "/chatter", lambda m: heard.append(m.data), 10)
+ok, msg = wait_for_message(String, node, "/chatter", time_to_wait=20.0)
+print("got:", ok, msg.data if ok else None, "| callbacks meanwhile:", len(heard), flush=True)
+ok, msg = wait_for_message(String, node, "/nobody_publishes_this", time_to_wait=0.1)
+print("nothing:", ok, msg, flush=True)
+rclpy.shutdown()
+'''
+
+
+def test_wait_for_message_returns_the_next_message_or_false_after_its_time(tmp_path):
+    script = tmp_path / "wait_for_message.py"
+    script.write_text(WAIT_FOR_MESSAGE)
+    program = Program(str(script), nodes=("Talker",))
+    assert program.finish() == 0, program.output
+    # as rclpy's wait set: the message, and the program's own callbacks did not run meanwhile
+    assert "got: True native" in program.output and "| callbacks meanwhile: 0" in program.output, program.output
+    assert "nothing: False None" in program.output
