@@ -31,7 +31,7 @@ _ALIASES = {
 _MISSING_MODULES = frozenset(
     {
         "rclpy.waitable", "rclpy.type_support",
-        "rclpy.topic_endpoint_info", "rclpy.parameter_service",
+        "rclpy.parameter_service",
         "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
         "rclpy.time_source", "rclpy.experimental",

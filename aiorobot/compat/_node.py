@@ -28,8 +28,6 @@ MISSING_NODE_METHODS = frozenset(
         "remove_waitable",
         "waitables",
         "handle",
-        "get_publishers_info_by_topic",
-        "get_subscriptions_info_by_topic",
         "get_clients_info_by_service",
         "get_servers_info_by_service",
     }
@@ -268,6 +266,18 @@ class NodeMixin:
         if guards is None:
             guards = self.__dict__["_guards"] = []
         return guards
+
+    def get_publishers_info_by_topic(self, topic_name: str, no_mangle: bool = False) -> list[Any]:
+        """rclpy's: the topic's publishers in the graph (this process and remote peers)."""
+        from .rclpy.topic_endpoint_info import endpoints_of
+
+        return endpoints_of(self, topic_name, "publisher", no_mangle)
+
+    def get_subscriptions_info_by_topic(self, topic_name: str, no_mangle: bool = False) -> list[Any]:
+        """rclpy's: the topic's subscriptions in the graph (this process and remote peers)."""
+        from .rclpy.topic_endpoint_info import endpoints_of
+
+        return endpoints_of(self, topic_name, "subscription", no_mangle)
 
     def create_guard_condition(self, callback: Callable[[], Any], callback_group: Any = None) -> Any:
         """A guard condition this node's executor runs ``callback`` for after each ``trigger()``."""

@@ -108,3 +108,33 @@ def test_wait_for_message_returns_the_next_message_or_false_after_its_time(tmp_p
     # as rclpy's wait set: the message, and the program's own callbacks did not run meanwhile
     assert "got: True native" in program.output and "| callbacks meanwhile: 0" in program.output, program.output
     assert "nothing: False None" in program.output
+
+
+ENDPOINT_INFO = '''
+import rclpy
+from rclpy.qos import ReliabilityPolicy
+from rclpy.topic_endpoint_info import TopicEndpointTypeEnum
+from std_msgs.msg import String
+
+rclpy.init()
+node = rclpy.create_node("inspector", namespace="/robot")
+node.create_subscription(String, "/chatter", lambda m: None, 10)
+rclpy.spin_once(node, timeout_sec=0.5)
+for p in node.get_publishers_info_by_topic("/chatter"):
+    print("publisher:", p.node_namespace, p.node_name, p.topic_type, p.endpoint_type.name,
+          p.qos_profile.reliability == ReliabilityPolicy.RELIABLE, p.topic_type_hash.startswith("RIHS01_"), flush=True)
+for s in node.get_subscriptions_info_by_topic("/chatter"):
+    print("subscription:", s.node_namespace, s.node_name, s.endpoint_type is TopicEndpointTypeEnum.SUBSCRIPTION, flush=True)
+print("unknown topic:", node.get_publishers_info_by_topic("/nothing"), flush=True)
+rclpy.shutdown()
+'''
+
+
+def test_get_publishers_and_subscriptions_info_by_topic_describe_the_graph(tmp_path):
+    script = tmp_path / "endpoint_info.py"
+    script.write_text(ENDPOINT_INFO)
+    program = Program(str(script), nodes=("Talker",))
+    assert program.finish() == 0, program.output
+    assert "publisher: / native_talker std_msgs/msg/String PUBLISHER True True" in program.output, program.output
+    assert "subscription: /robot inspector True" in program.output
+    assert "unknown topic: []" in program.output
