@@ -79,10 +79,14 @@ async def test_timeout_follows_sim_time(sim_runtime, sim_clock):
     server = runtime_node = sim_runtime.add_node(Node("server"))
     server.create_service(Trigger, "never", lambda req: asyncio.Event().wait())
     client = sim_runtime.add_node(Node("client")).create_client(Trigger, "never")
-    call = asyncio.ensure_future(client.call(Trigger.Request(), timeout_sec=1.0))
-    await sim_clock.advance(0.9)
-    assert not call.done()  # wall time passes, sim time has not reached the timeout
-    await sim_clock.advance(0.2)
+    call = asyncio.ensure_future(client.call(Trigger.Request(), timeout_sec=0.05))
+    await settle(sim_runtime)  # the call is under way; its timeout counts from sim time 0
+    # Wall time passes, four times the timeout, and sim time does not: a wall-clock timeout
+    # would fire here. (Stepping sim time in 10 ms steps past a busy server made this test
+    # spend 10 s in settle's max_rounds.)
+    await asyncio.sleep(0.2)
+    assert not call.done()
+    await sim_clock.advance(0.1, step_sec=0.05)
     with pytest.raises(TimeoutError):
         await call
     del runtime_node
