@@ -102,6 +102,7 @@ _EXPORTS = {
     "TimerStatistics": "_timer",
     "TopicInfo": "_graph",
     "Transport": "_transport",
+    "compile_kernels": "_warm_up",
     "load_config": "_config",
     "qos_profile_sensor_data": "_qos",
     "qos_profile_system_default": "_qos",
@@ -120,6 +121,7 @@ __all__ = [
     "ClockChange",
     "ClockPublisher",
     "ClockType",
+    "compile_kernels",
     "ConfigError",
     "DurabilityPolicy",
     "Duration",
@@ -225,6 +227,7 @@ if TYPE_CHECKING:
     from ._time import ClockType, Duration, Infinite, Time
     from ._timer import Rate, Timer, TimerInfo, TimerStatistics
     from ._transport import LocalTransport, Transport
+    from ._warm_up import compile_kernels
 
 
 _SUBPACKAGES = frozenset(

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from aiorobot import Node
+from aiorobot import Node, compile_kernels
 
 from ._ekf import STATE_SIZE, Ekf, check_covariance
 from ._inputs import (
@@ -66,7 +66,7 @@ class EkfNode(Node):
         for ignored in sorted(set(given) & set(IGNORED_PARAMETERS)):
             self.declare_parameter(ignored, self._override_type_default(ignored))
             self.get_logger().warning(f"robot_localization parameter {ignored!r} has no effect in aiorobot")
-        Ekf.warm_up()  # Numba's first-call cost here, not on the priority loop at the first message
+        compile_kernels(self.get_logger(), Ekf.warm_up)  # here, not on the priority loop at the first message
         self.ekf = Ekf(
             process_noise=p["process_noise_covariance"],
             initial_covariance=p["initial_estimate_covariance"],

@@ -88,7 +88,8 @@ def check_message_covariance(what: str, values: object, size: int) -> NDArray[np
     """A row-major ``size x size`` covariance: finite, symmetric, positive semi-definite."""
     from ._kernels import covariance_status
 
-    arr = np.asarray(values, dtype=np.float64).reshape(-1)
+    # a writable copy: a message's read-only array would select a second compiled version of the kernel
+    arr = np.array(values, dtype=np.float64).reshape(-1)
     if arr.size != size * size:
         raise InputRejected(f"{what} covariance has {arr.size} values, expected {size * size}")
     C = arr.reshape(size, size)

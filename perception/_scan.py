@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from ._images import BadInput
 
-__all__ = ["extract_obstacles", "scan_to_points", "segment_scan"]
+__all__ = ["extract_obstacles", "scan_to_points", "segment_scan", "warm_up"]
 
 
 def scan_to_points(msg: Any) -> NDArray[np.float64]:
@@ -118,3 +118,9 @@ def extract_obstacles(points: NDArray[np.float64], labels: NDArray[np.int64]) ->
     labels = np.ascontiguousarray(labels, dtype=np.int64)
     count = int(labels.max()) + 1 if labels.size else 0
     return _obstacle_kernel()(np.ascontiguousarray(points, dtype=np.float64), labels, count)
+
+
+def warm_up() -> None:
+    """Compile (first run) or load both kernels with the argument types the functions above pass."""
+    points = np.array([[1.0, 0.0], [1.0, 0.05], [1.0, 0.1]])
+    extract_obstacles(points, segment_scan(points, 0.2, 3))

@@ -6,11 +6,11 @@ from typing import Any
 
 import numpy as np
 
-from aiorobot import Node
+from aiorobot import Node, compile_kernels
 
 from ._cloud import xyz_to_cloud
 from ._images import BadInput
-from ._scan import extract_obstacles, scan_to_points, segment_scan
+from ._scan import extract_obstacles, scan_to_points, segment_scan, warm_up
 
 __all__ = ["ScanObstacleNode", "scan_obstacles"]
 
@@ -49,6 +49,7 @@ class ScanObstacleNode(Node):
         self.dropped = 0
         self.processed = 0
         self.create_subscription(LaserScan, scan_topic, self.on_scan, 5)
+        compile_kernels(self.get_logger(), warm_up)  # not in the first scan's callback
 
     async def on_scan(self, msg: Any) -> None:
         from aiorobot.msgs.geometry_msgs import Pose, PoseArray

@@ -312,7 +312,6 @@ async def run_demo(
     probe = _PeriodProbe(graph.control_node.timers[0])
     summary.control_loop = f"{graph.control_node.get_name()} {1.0 / probe.period_sec:g} Hz on the priority loop"
     sim, server = graph.simulator, graph.server
-    # The simulator compiles its Numba kernels when it starts: seconds on the main loop, on purpose.
     baseline: _SleepBaseline | None = None
     async with Runtime(use_sim_time=graph.time_source == "sim", stall_threshold=10.0, priority_realtime=realtime) as rt:
         rt.add_nodes(graph.nodes)

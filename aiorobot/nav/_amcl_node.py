@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._node import Node
+from .._warm_up import compile_kernels
 from .._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ._amcl import Amcl, AmclParameters
 from ._geometry import transform_to_xyyaw, xyyaw, yaw_quaternion
@@ -70,6 +71,9 @@ class AmclNode(Node):
         self.pose_pub = self.create_publisher(PoseWithCovarianceStamped, "amcl_pose",
                                               QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1))
         self._map_to_odom: tuple[float, float, float] | None = None
+        from ._kernels import warm_up
+
+        compile_kernels(self.get_logger(), lambda: warm_up("likelihood_weights"))  # not at the first scan
 
     # -- inputs -------------------------------------------------------------------------
 

@@ -7,7 +7,7 @@ import math
 import numba
 import numpy as np
 
-__all__ = ["astar", "likelihood_weights", "raytrace_clear"]
+__all__ = ["astar", "integrate_scan", "likelihood_weights", "raytrace_clear", "shortcut", "warm_up"]
 
 _SQRT2 = math.sqrt(2.0)
 
@@ -298,3 +298,30 @@ def shortcut(cost, cells, max_skip):  # pragma: no cover
         out[m, 0] = cells[keep[m], 0]
         out[m, 1] = cells[keep[m], 1]
     return out
+
+
+def warm_up(*kernels: str) -> None:
+    """Compile (first run) or load the named kernels (default: all) on tiny inputs.
+
+    The argument types are those the navigation cores pass (``plan``, ``Costmap.mark_scan``,
+    ``Amcl._sense``, ``OccupancyMapper.integrate``): contiguous float64 / uint8 / int64 / bool
+    arrays and Python floats, so the real calls find the compiled version.
+    """
+    names = kernels or ("astar", "shortcut", "raytrace_clear", "likelihood_weights", "integrate_scan")
+    unknown = sorted(set(names) - {"astar", "shortcut", "raytrace_clear", "likelihood_weights", "integrate_scan"})
+    if unknown:
+        raise ValueError(f"warm_up: unknown kernels {unknown}")
+    cost = np.zeros((4, 4), dtype=np.uint8)
+    points = np.zeros((2, 2))
+    hits = np.ones(2, dtype=np.bool_)
+    if "astar" in names:
+        astar(cost, 0, 0, 3, 3, 1.0, 3.0, True)
+    if "shortcut" in names:
+        shortcut(cost, np.array([[0, 0], [1, 1], [2, 2]], dtype=np.int64), 400)
+    if "raytrace_clear" in names:
+        raytrace_clear(cost.copy(), 0.1, 0.1, points, hits, 0.0, 0.0, 0.05, 2.5, 3.0)
+    if "likelihood_weights" in names:
+        likelihood_weights(np.zeros((2, 3)), np.ones(2), np.zeros(2), np.zeros((4, 4)), 0.0, 0.0, 0.05,
+                           0.0, 0.0, 0.0, 0.1, 3.5, 0.5, 0.5, 0.2, 2.0)
+    if "integrate_scan" in names:
+        integrate_scan(np.zeros((4, 4)), 0.1, 0.1, points, hits, 0.0, 0.0, 0.05, -0.4, 0.85, -2.0, 3.5)

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._node import Node
+from .._warm_up import compile_kernels
 from .._qos import QoSProfile, ReliabilityPolicy
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
@@ -91,6 +92,9 @@ class MappingNode(Node):
         self.create_subscription(LaserScan, "/scan", self._on_scan, QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=5))
         self.pub = self.create_publisher(OccupancyGrid, "/map", MAP_QOS)
         self.create_timer(float(d("publish_period", 1.0).value), self.publish_map)
+        from ._kernels import warm_up
+
+        compile_kernels(self.get_logger(), lambda: warm_up("integrate_scan"))  # not at the first scan
 
     def _on_scan(self, scan: Any) -> None:
         from aiorobot import Time

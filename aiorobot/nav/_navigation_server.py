@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .._node import Node
+from .._warm_up import compile_kernels
 from .._qos import QoSProfile, ReliabilityPolicy
 from ._costmap import Costmap
 from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
@@ -106,6 +107,9 @@ class NavigationServer(Node):
         self.localization_lost: str | None = None
         self._subscribe_localization()
         self._busy = False
+        from ._kernels import warm_up
+
+        compile_kernels(self.get_logger(), lambda: warm_up("astar", "shortcut", "raytrace_clear"))  # not at the first goal
         self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from aiorobot import Node, QoSProfile
+from aiorobot import Node, QoSProfile, compile_kernels
 from aiorobot._qos import DurabilityPolicy
 
 from ._camera import CameraModel, MarkerRenderer, camera_pose_matrix
@@ -251,7 +251,7 @@ class Simulator(Node):
         self._tf = tf.TransformBroadcaster(self) if self.publish_odom_tf else None
         # at construction, before any loop runs: a first run after installing compiles the kernels
         # (seconds), which on a running loop is a stall the loop monitor rightly reports
-        self._warm_up()
+        compile_kernels(self.get_logger(), self._warm_up)
 
     def __repr__(self) -> str:
         return f"<Simulator {self.world.name} {self.robot_kind} t={self.time_ns / _NS:.3f}s rtf={self.real_time_factor:g}>"
