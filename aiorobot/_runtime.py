@@ -216,6 +216,9 @@ class Runtime:
                 self._on_clock,
                 owner="<runtime clock>",
             )
+            # the runtime's time source follows /clock from other processes too (a simulator, `bag play
+            # --clock`), not only when one of its nodes happens to subscribe to /clock itself
+            self._clock_tap.wants_remote = True
             self._bus.add_subscription(self._clock_tap)
         self._state = "running"
         if self._bus.debug_messages:

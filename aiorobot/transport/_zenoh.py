@@ -691,7 +691,8 @@ class ZenohTransport(Transport):
 
     def _add_subscription(self, sub: Subscription[Any]) -> None:
         type_hash = self._hash(sub.msg_type)
-        self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
+        if sub.node is not None:  # the runtime's /clock tap has no node: it receives without a graph entry
+            self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
         key = (sub.topic_name, sub.type_name)
         inb = self._inbound.get(key)
         new = inb is None
@@ -931,6 +932,6 @@ def _ignore(_msg: Any) -> None:
 
 
 def _own_tap(endpoint: Any) -> bool:
-    """A tap that is not a subscriber of remote data (the transport's own outbound taps, the
-    runtime's /clock tap): recorders and bridges mark theirs with ``wants_remote`` and a node."""
-    return isinstance(endpoint, Tap) and not (getattr(endpoint, "wants_remote", False) and endpoint.node is not None)
+    """A tap that is not a subscriber of remote data (the transport's own outbound taps): recorders,
+    bridges and the runtime's /clock tap mark theirs with ``wants_remote``."""
+    return isinstance(endpoint, Tap) and not getattr(endpoint, "wants_remote", False)
