@@ -116,6 +116,8 @@ def test_every_command_has_help(capsys: pytest.CaptureFixture[str]) -> None:
     top = capsys.readouterr().out
     for name in COMMANDS:
         assert name in top
+    # what `aiorobot run` with no file does: the demo, not "the bundled example" it once said
+    assert "with no file, the demo" in " ".join(top.split()) and "bundled example" not in top
     assert main(["run", "--help"]) == 0
     run_help = capsys.readouterr().out
     assert "usage: aiorobot run" in run_help and "--duration SEC" in run_help

@@ -18,7 +18,7 @@ __all__ = ["COMMANDS", "main"]
 
 #: name -> (module implementing it, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config (default: the bundled example)"),
+    "run": ("aiorobot.cli._run", "run a graph of nodes from a TOML config; with no file, the demo (the simulated robot's warehouse mission)"),
     "bench": ("aiorobot.bench._cli", "executor and transport latency benchmark"),
     "bag": ("aiorobot.cli._bag", "record, play, inspect and repair rosbag2 (MCAP) bags"),
     "foxglove": ("aiorobot.cli._foxglove", "serve the graph live to the Foxglove app (WebSocket)"),

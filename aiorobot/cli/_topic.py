@@ -23,6 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     for verb in ("echo", "hz", "bw"):
         p = verbs.add_parser(verb, help={"echo": "print messages as YAML", "hz": "message rate", "bw": "bandwidth"}[verb])
         p.add_argument("name")
+        p.add_argument("type", nargs="?", default=None,
+                       help="message type, e.g. std_msgs/msg/String (default: the type the graph shows; "
+                            "a topic not published yet is waited for)")
         p.add_argument("--once", action="store_true", help="stop after one message (echo) or one report")
         p.add_argument("--count", "-n", type=int, default=None, help="stop after N messages")
     p = verbs.add_parser("pub", help="publish a message given as YAML")
@@ -40,14 +43,18 @@ def main(args: argparse.Namespace) -> int:
     return run_verb("topic", args, _main, interrupted=0)
 
 
-async def _main(args: argparse.Namespace) -> int:
-    if args.verb == "pub":
-        from ..msgs import get
+def _message_type(name: str) -> Any:
+    from ..msgs import get
 
-        try:
-            msg_type = get(args.type)
-        except Exception:
-            raise UserError(f"type: expected a known message type such as geometry_msgs/msg/Twist, found {args.type!r}") from None
+    try:
+        return get(name)
+    except Exception:
+        raise UserError(f"type: expected a known message type such as geometry_msgs/msg/Twist, found {name!r}") from None
+
+
+async def _main(args: argparse.Namespace) -> int:
+    msg_type = _message_type(args.type) if getattr(args, "type", None) is not None else None  # before joining
+    if args.verb == "pub":
         msg = fill_message(msg_type, args.values)  # before joining: a bad message starts nothing
     async with join_graph(args) as rt:
         graph = rt.graph
@@ -59,7 +66,7 @@ async def _main(args: argparse.Namespace) -> int:
             return _info(graph, args)
         if args.verb == "pub":
             return await _pub(rt, args, msg_type, msg)
-        return await _listen(rt, graph, args)
+        return await _listen(rt, args, msg_type)
 
 
 def _info(graph: Any, args: argparse.Namespace) -> int:
@@ -100,14 +107,31 @@ async def _pub(rt: Any, args: argparse.Namespace, msg_type: Any, msg: Any) -> in
     return 0
 
 
-async def _listen(rt: Any, graph: Any, args: argparse.Namespace) -> int:
-    from .. import Node, QoSProfile, ReliabilityPolicy
-    from ..msgs import get, serialize
+async def _wait_for_type(rt: Any, args: argparse.Namespace, msg_type: Any) -> Any:
+    """The type to subscribe with; for a topic with no publisher yet, one warning, then (with no type
+    given) wait until one appears, as ``ros2 topic echo`` / ``hz`` wait for the topic's type."""
+    from ..msgs import get
 
-    topic = graph.topic(args.name)
-    if topic is None or not topic.types:
-        raise UserError(f"unknown topic {args.name!r}; 'aiorobot topic list' shows the topics")
-    msg_type = get(topic.types[0])
+    topic = rt.graph.topic(args.name)
+    if topic is None or not topic.publishers:
+        print(f"WARNING: topic [{args.name}] does not appear to be published yet; waiting for it (Ctrl-C stops)",
+              file=sys.stderr, flush=True)
+    elif msg_type is not None and msg_type.__msgtype__ not in topic.types:
+        print(f"WARNING: topic [{args.name}] is published as {' | '.join(topic.types)}, not {msg_type.__msgtype__}: "
+              "its messages will not arrive", file=sys.stderr, flush=True)
+    while msg_type is None:
+        topic = rt.graph.topic(args.name)
+        if topic is not None and topic.publishers and topic.types:
+            return get(topic.types[0])
+        await asyncio.sleep(0.1)
+    return msg_type
+
+
+async def _listen(rt: Any, args: argparse.Namespace, msg_type: Any) -> int:
+    from .. import Node, QoSProfile, ReliabilityPolicy
+    from ..msgs import serialize
+
+    msg_type = await _wait_for_type(rt, args, msg_type)
     # best effort subscribes to every publisher, reliable or not, as ros2 topic echo's default adapts
     qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=10)
     node = rt.add_node(Node(f"aiorobot_topic_{args.verb}_{int(time.time() * 1000) % 100000}"))

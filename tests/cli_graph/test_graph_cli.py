@@ -115,5 +115,3 @@ async def test_topic_pub_with_yaml_that_does_not_fit_the_type_names_the_field(gr
         "aiorobot topic pub: error: geometry_msgs/msg/Twist.linear.q: geometry_msgs/msg/Vector3 has no field 'q'; "
         "its fields are x, y, z"
     ]
-    code, out, err = await cli(port, "topic", "echo", "/nope", "--once")
-    assert code == 1 and "unknown topic '/nope'" in err and "Traceback" not in err
