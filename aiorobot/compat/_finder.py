@@ -1,7 +1,7 @@
 """The import aliases: ``rclpy``, message packages, ``tf2_ros``, ``message_filters`` -> aiorobot.
 
 A meta path finder placed first on ``sys.meta_path``: ``rclpy[.x]`` resolves to
-``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters`` to
+``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters``/``cv_bridge`` to
 their aiorobot modules, and ``<pkg>.msg|srv|action`` to module views of
 ``aiorobot.msgs`` for every package aiorobot has interfaces of.
 """
@@ -26,6 +26,7 @@ _ALIASES = {
     "tf2_geometry_msgs": "aiorobot.compat.tf2_geometry_msgs",
     "message_filters": "aiorobot.message_filters",
     "sensor_msgs_py": "aiorobot.compat.sensor_msgs_py",
+    "cv_bridge": "aiorobot.compat.cv_bridge",
 }
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(
