@@ -1,7 +1,7 @@
 """The import aliases: ``rclpy``, message packages, ``tf2_ros``, ``message_filters`` -> aiorobot.
 
 A meta path finder placed first on ``sys.meta_path``: ``rclpy[.x]`` resolves to
-``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters`` to
+``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters``/``cv_bridge`` to
 their aiorobot modules, and ``<pkg>.msg|srv|action`` to module views of
 ``aiorobot.msgs`` for every package aiorobot has interfaces of.
 """
@@ -16,7 +16,7 @@ import types
 import warnings
 from typing import Any
 
-from ._missing import not_provided
+from ._missing import MissingInterfaceError, not_provided
 
 __all__ = ["AliasFinder", "install", "uninstall"]
 
@@ -26,6 +26,7 @@ _ALIASES = {
     "tf2_geometry_msgs": "aiorobot.compat.tf2_geometry_msgs",
     "message_filters": "aiorobot.message_filters",
     "sensor_msgs_py": "aiorobot.compat.sensor_msgs_py",
+    "cv_bridge": "aiorobot.compat.cv_bridge",
 }
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(
@@ -72,27 +73,56 @@ def _interface_module(package: str, kind: str) -> types.ModuleType:
     module.__all__ = names  # type: ignore[attr-defined]
 
     def __getattr__(name: str) -> Any:
-        if name in names:
+        if name in names or exists(f"{package}/{kind}/{name}"):  # registered after the import
             cls = get(f"{package}/{kind}/{name}")
             setattr(module, name, cls)
             return cls
         if name.startswith("_"):
             raise AttributeError(f"module {fullname!r} has no attribute {name!r}")
-        raise ImportError(
-            f"aiorobot does not provide {fullname}.{name} ({package}/{kind}/{name} is not among its "
-            f"interface types; register it with aiorobot.msgs.register_file)"
-        )
+        raise missing_interface(package, kind, name)
 
     module.__getattr__ = __getattr__  # type: ignore[attr-defined]
     return module
 
 
+def missing_interface(package: str, kind: str, name: str) -> MissingInterfaceError:
+    """The one-line error for ``from <package>.<kind> import <name>`` of an unknown type."""
+    import difflib
+
+    from ..msgs._registry import exists, package_names
+
+    fullname = f"{package}.{kind}"
+    names = [n for n in package_names(package) if exists(f"{package}/{kind}/{n}")]
+    close = difflib.get_close_matches(name, names, n=3)
+    hint = f" (did you mean {', '.join(close)}?)" if close else ""
+    return MissingInterfaceError(
+        f"cannot import name {name!r} from {fullname!r}: aiorobot has no {package}/{kind}/{name}{hint}; "
+        f"for your own or a newer {package}, pass its folder with --interfaces DIR",
+        name=fullname,
+    )
+
+
+def missing_package(package: str) -> MissingInterfaceError:
+    """The one-line error for ``from <package>.msg|srv|action import ...`` of an unknown package."""
+    return MissingInterfaceError(
+        f"no interface package {package!r}: aiorobot has ROS 2 Jazzy's standard ones; pass the folder of "
+        f"{package} (its package.xml, msg/, srv/, action/) with `aiorobot exec --interfaces DIR` "
+        f"or in AIOROBOT_INTERFACES",
+        name=package,
+    )
+
+
 class AliasFinder(importlib.abc.MetaPathFinder):
     def __init__(self) -> None:
         self._packages: frozenset[str] | None = None
+        self._generation = -1
 
     def packages(self) -> frozenset[str]:
-        if self._packages is None:
+        """The ROS packages aiorobot has interfaces of, registered ones included."""
+        from ..msgs._registry import generation
+
+        if self._packages is None or self._generation != generation():
+            self._generation = generation()
             self._packages = _msg_packages()
         return self._packages
 

@@ -4,13 +4,21 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["DOCS_URL", "NotProvidedError", "module_getattr", "not_provided"]
+__all__ = ["DOCS_URL", "MissingInterfaceError", "NotProvidedError", "module_getattr", "not_provided"]
 
 DOCS_URL = "https://github.com/aiorobot/aiorobot/blob/main/docs/rclpy-compat.md"
 
 
 class NotProvidedError(NotImplementedError):
     """An rclpy name aiorobot does not implement yet (raised where the program uses it)."""
+
+
+class MissingInterfaceError(ImportError):
+    """``from <pkg>.msg|srv|action import <Name>`` of a type aiorobot does not know.
+
+    An ImportError, as with rclpy (``except ImportError`` still works); ``aiorobot exec``
+    prints it in one line at the program's line.
+    """
 
 
 def not_provided(qualname: str) -> NotProvidedError:

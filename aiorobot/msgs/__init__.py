@@ -11,6 +11,11 @@ takes keyword or positional fields in definition order, compares by value and na
 its ROS type in ``__msgtype__``. ``serialize``/``deserialize`` speak ROS 2 CDR,
 byte-identical to ROS 2. Classes are generated on first use, so importing a
 package module costs next to nothing.
+
+Your own interface packages (a folder with package.xml and msg/, srv/, action/ files)::
+
+    msgs.register_package("src/my_msgs")                   # or a workspace folder of packages
+    from aiorobot.msgs.my_msgs import Foo                  # or msgs.get("my_msgs/msg/Foo")
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from ._cdr import DeserializationError, SerializationError, deserialize, seriali
 from ._classgen import Action, Message, ReadOnlyMessageError, Service
 from ._describe import message_definition, type_hash
 from ._registry import get, register_action, register_file, register_msg, register_srv
+from ._ros_packages import register_from_env, register_package
 
 __all__ = [
     "Action",
@@ -32,7 +38,9 @@ __all__ = [
     "message_definition",
     "register_action",
     "register_file",
+    "register_from_env",
     "register_msg",
+    "register_package",
     "register_srv",
     "serialize",
     "type_hash",

@@ -21,11 +21,13 @@ __all__ = [
     "ServiceSpec",
     "all_names",
     "exists",
+    "generation",
     "get",
     "get_spec",
     "package_names",
     "register_action",
     "register_file",
+    "register_many",
     "register_msg",
     "register_srv",
 ]
@@ -59,6 +61,7 @@ _lock = threading.RLock()
 _specs: dict[str, Spec] = {}  # every loaded spec, incl. srv/action parts
 _classes: dict[str, type] = {}
 _shipped_index: dict[str, Path] | None = None
+_generation = 0  # counts registrations, so that views of the registry know when to look again
 
 
 def _shipped() -> dict[str, Path]:
@@ -279,6 +282,7 @@ def _register(text: str, name: str, kind: str) -> type:
                 f"{_describe(existing)}\nnew definition:\n{_describe(spec)}\n"
                 "Use a different type name for the new definition.")
         _install(spec)
+        _bump()
         try:
             return get(name)
         except LookupError as exc:  # a nested type is unknown: register nothing
@@ -334,6 +338,71 @@ def register_file(path: str | Path) -> type:
                          "'<pkg>/action/<Name>.action'")
     name = f"{p.parent.parent.name}/{kind}/{p.stem}"
     return _register(p.read_text(encoding="utf-8"), name, kind)
+
+
+def generation() -> int:
+    """A number that changes whenever a definition is registered."""
+    return _generation
+
+
+def _bump() -> None:
+    global _generation
+    _generation += 1
+
+
+def _known(name: str) -> Spec | None:
+    try:
+        return get_spec(name)
+    except LookupError:
+        return None
+
+
+def register_many(definitions: list[tuple[str, str, str]]) -> list[str]:
+    """Register ``(name, text, origin)`` definitions together; the names registered.
+
+    The definitions may use one another in any order (a package's messages, or several
+    packages that depend on each other). ``origin`` (a file path) starts every error.
+    All or nothing: a parse error, a conflict with a known definition or a field type
+    that is neither known nor among ``definitions`` registers none of them.
+    """
+    specs: list[tuple[Spec, str]] = []
+    for name, text, origin in definitions:
+        _check_name(name, name.split("/")[1] if name.count("/") == 2 else "msg")
+        try:
+            specs.append((_parse_text(text, name), origin))
+        except ValueError as err:
+            raise ValueError(f"{origin}: {err}") from None
+    with _lock:
+        new: list[tuple[Spec, str]] = []
+        for spec, origin in specs:
+            existing = _known(spec.name)
+            if existing is None:
+                new.append((spec, origin))
+            elif not _same(existing, spec):
+                raise ValueError(
+                    f"{origin}: defines {spec.name} differently from the definition aiorobot already "
+                    f"has:\n{_describe(existing)}\nthis file:\n{_describe(spec)}\n"
+                    "A package may not redefine a type of another (aiorobot ships ROS 2 Jazzy's).")
+        for spec, _ in new:
+            _install(spec)
+        for spec, origin in new:
+            for part in _parts(spec):
+                if not isinstance(part, MsgSpec):
+                    continue
+                for dep in part.dependencies():
+                    if not exists(dep):
+                        for undo, _ in new:
+                            for p in _parts(undo):
+                                _specs.pop(p.name, None)
+                        pkg, _, short = dep.split("/")
+                        if pkg in {s.name.split("/", 1)[0] for s, _ in new}:
+                            raise LookupError(f"{origin}: {spec.name} uses {dep}, which is unknown: "
+                                              f"package {pkg!r} has no msg/{short}.msg")
+                        raise LookupError(
+                            f"{origin}: {spec.name} uses {dep}, which is unknown; add the folder of "
+                            f"package {pkg!r} too (or register that type first)")
+        _bump()
+    return [spec.name for spec, _ in specs]
 
 
 def rebuild(msgtype: str, values: tuple[Any, ...]) -> Any:

@@ -11,9 +11,11 @@ from typing import Any
 from ._package import package_getattr
 
 __all__ = [
+    "AddDiagnostics",
     "DiagnosticArray",
     "DiagnosticStatus",
     "KeyValue",
+    "SelfTest",
 ]
 
 

@@ -7,10 +7,29 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aiorobot.msgs import Action, Message, Service
+from aiorobot.msgs import service_msgs as _service_msgs
 from aiorobot.msgs import std_msgs as _std_msgs
 
-__all__ = ['DiagnosticArray', 'DiagnosticStatus', 'KeyValue']
+__all__ = ['AddDiagnostics', 'DiagnosticArray', 'DiagnosticStatus', 'KeyValue', 'SelfTest']
 
+
+class AddDiagnostics(Service):
+    __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/AddDiagnostics"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/AddDiagnostics_Request"
+        load_namespace: str
+        def __init__(self, load_namespace: str = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/AddDiagnostics_Response"
+        success: bool
+        message: str
+        def __init__(self, success: bool = ..., message: str = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/AddDiagnostics_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[AddDiagnostics.Request]
+        response: list[AddDiagnostics.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[AddDiagnostics.Request] | None = ..., response: Sequence[AddDiagnostics.Response] | None = ...) -> None: ...
 
 class DiagnosticArray(Message):
     __msgtype__: ClassVar[str] = "diagnostic_msgs/msg/DiagnosticArray"
@@ -36,3 +55,22 @@ class KeyValue(Message):
     key: str
     value: str
     def __init__(self, key: str = ..., value: str = ...) -> None: ...
+
+class SelfTest(Service):
+    __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/SelfTest"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/SelfTest_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/SelfTest_Response"
+        id: str
+        passed: int
+        status: list[DiagnosticStatus]
+        def __init__(self, id: str = ..., passed: int = ..., status: Sequence[DiagnosticStatus] | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "diagnostic_msgs/srv/SelfTest_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SelfTest.Request]
+        response: list[SelfTest.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SelfTest.Request] | None = ..., response: Sequence[SelfTest.Response] | None = ...) -> None: ...

@@ -8,13 +8,390 @@ from numpy.typing import ArrayLike, NDArray
 
 from aiorobot.msgs import Action, Message, Service
 from aiorobot.msgs import builtin_interfaces as _builtin_interfaces
+from aiorobot.msgs import geographic_msgs as _geographic_msgs
 from aiorobot.msgs import geometry_msgs as _geometry_msgs
 from aiorobot.msgs import nav_msgs as _nav_msgs
 from aiorobot.msgs import service_msgs as _service_msgs
+from aiorobot.msgs import std_msgs as _std_msgs
 from aiorobot.msgs import unique_identifier_msgs as _unique_identifier_msgs
 
-__all__ = ['ComputePathToPose', 'FollowWaypoints', 'MissedWaypoint', 'NavigateThroughPoses', 'NavigateToPose']
+__all__ = ['AssistedTeleop', 'BackUp', 'BehaviorTreeLog', 'BehaviorTreeStatusChange', 'ClearCostmapAroundPose', 'ClearCostmapAroundRobot', 'ClearCostmapExceptRegion', 'ClearEntireCostmap', 'CollisionDetectorState', 'CollisionMonitorState', 'ComputeAndTrackRoute', 'ComputePathThroughPoses', 'ComputePathToPose', 'ComputeRoute', 'Costmap', 'CostmapFilterInfo', 'CostmapMetaData', 'CostmapUpdate', 'DockRobot', 'DriveOnHeading', 'DummyBehavior', 'DynamicEdges', 'EdgeCost', 'FollowGPSWaypoints', 'FollowObject', 'FollowPath', 'FollowWaypoints', 'GetCost', 'GetCostmap', 'IsPathValid', 'LoadMap', 'ManageLifecycleNodes', 'MissedWaypoint', 'NavigateThroughPoses', 'NavigateToPose', 'Particle', 'ParticleCloud', 'ReloadDockDatabase', 'Route', 'RouteEdge', 'RouteNode', 'SaveMap', 'SetInitialPose', 'SetRouteGraph', 'SmoothPath', 'SpeedLimit', 'Spin', 'Toggle', 'UndockRobot', 'VoxelGrid', 'Wait']
 
+
+class AssistedTeleop(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_Goal"
+        time_allowance: _builtin_interfaces.Duration
+        def __init__(self, time_allowance: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 730
+        TIMEOUT: Final = 731
+        TF_ERROR: Final = 732
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_Feedback"
+        current_teleop_duration: _builtin_interfaces.Duration
+        def __init__(self, current_teleop_duration: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: AssistedTeleop.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: AssistedTeleop.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[AssistedTeleop.SendGoal.Request]
+            response: list[AssistedTeleop.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[AssistedTeleop.SendGoal.Request] | None = ..., response: Sequence[AssistedTeleop.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_GetResult_Response"
+            status: int
+            result: AssistedTeleop.Result
+            def __init__(self, status: int = ..., result: AssistedTeleop.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[AssistedTeleop.GetResult.Request]
+            response: list[AssistedTeleop.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[AssistedTeleop.GetResult.Request] | None = ..., response: Sequence[AssistedTeleop.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/AssistedTeleop_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: AssistedTeleop.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: AssistedTeleop.Feedback | None = ...) -> None: ...
+
+class BackUp(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_Goal"
+        target: _geometry_msgs.Point
+        speed: float
+        time_allowance: _builtin_interfaces.Duration
+        def __init__(self, target: _geometry_msgs.Point | None = ..., speed: float = ..., time_allowance: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 710
+        TIMEOUT: Final = 711
+        TF_ERROR: Final = 712
+        INVALID_INPUT: Final = 713
+        COLLISION_AHEAD: Final = 714
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_Feedback"
+        distance_traveled: float
+        def __init__(self, distance_traveled: float = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: BackUp.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: BackUp.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[BackUp.SendGoal.Request]
+            response: list[BackUp.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[BackUp.SendGoal.Request] | None = ..., response: Sequence[BackUp.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_GetResult_Response"
+            status: int
+            result: BackUp.Result
+            def __init__(self, status: int = ..., result: BackUp.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[BackUp.GetResult.Request]
+            response: list[BackUp.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[BackUp.GetResult.Request] | None = ..., response: Sequence[BackUp.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/BackUp_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: BackUp.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: BackUp.Feedback | None = ...) -> None: ...
+
+class BehaviorTreeLog(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/BehaviorTreeLog"
+    timestamp: _builtin_interfaces.Time
+    event_log: list[BehaviorTreeStatusChange]
+    def __init__(self, timestamp: _builtin_interfaces.Time | None = ..., event_log: Sequence[BehaviorTreeStatusChange] | None = ...) -> None: ...
+
+class BehaviorTreeStatusChange(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/BehaviorTreeStatusChange"
+    timestamp: _builtin_interfaces.Time
+    node_name: str
+    uid: int
+    previous_status: str
+    current_status: str
+    def __init__(self, timestamp: _builtin_interfaces.Time | None = ..., node_name: str = ..., uid: int = ..., previous_status: str = ..., current_status: str = ...) -> None: ...
+
+class ClearCostmapAroundPose(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundPose"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundPose_Request"
+        pose: _geometry_msgs.PoseStamped
+        reset_distance: float
+        def __init__(self, pose: _geometry_msgs.PoseStamped | None = ..., reset_distance: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundPose_Response"
+        response: _std_msgs.Empty
+        def __init__(self, response: _std_msgs.Empty | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundPose_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[ClearCostmapAroundPose.Request]
+        response: list[ClearCostmapAroundPose.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ClearCostmapAroundPose.Request] | None = ..., response: Sequence[ClearCostmapAroundPose.Response] | None = ...) -> None: ...
+
+class ClearCostmapAroundRobot(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundRobot"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundRobot_Request"
+        reset_distance: float
+        def __init__(self, reset_distance: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundRobot_Response"
+        response: _std_msgs.Empty
+        def __init__(self, response: _std_msgs.Empty | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapAroundRobot_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[ClearCostmapAroundRobot.Request]
+        response: list[ClearCostmapAroundRobot.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ClearCostmapAroundRobot.Request] | None = ..., response: Sequence[ClearCostmapAroundRobot.Response] | None = ...) -> None: ...
+
+class ClearCostmapExceptRegion(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapExceptRegion"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapExceptRegion_Request"
+        reset_distance: float
+        def __init__(self, reset_distance: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapExceptRegion_Response"
+        response: _std_msgs.Empty
+        def __init__(self, response: _std_msgs.Empty | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearCostmapExceptRegion_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[ClearCostmapExceptRegion.Request]
+        response: list[ClearCostmapExceptRegion.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ClearCostmapExceptRegion.Request] | None = ..., response: Sequence[ClearCostmapExceptRegion.Response] | None = ...) -> None: ...
+
+class ClearEntireCostmap(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearEntireCostmap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearEntireCostmap_Request"
+        request: _std_msgs.Empty
+        def __init__(self, request: _std_msgs.Empty | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearEntireCostmap_Response"
+        response: _std_msgs.Empty
+        def __init__(self, response: _std_msgs.Empty | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ClearEntireCostmap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[ClearEntireCostmap.Request]
+        response: list[ClearEntireCostmap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ClearEntireCostmap.Request] | None = ..., response: Sequence[ClearEntireCostmap.Response] | None = ...) -> None: ...
+
+class CollisionDetectorState(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/CollisionDetectorState"
+    polygons: list[str]
+    detections: NDArray[np.bool_]
+    def __init__(self, polygons: Sequence[str] | None = ..., detections: ArrayLike | None = ...) -> None: ...
+
+class CollisionMonitorState(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/CollisionMonitorState"
+    DO_NOTHING: Final = 0
+    STOP: Final = 1
+    SLOWDOWN: Final = 2
+    APPROACH: Final = 3
+    LIMIT: Final = 4
+    action_type: int
+    polygon_name: str
+    def __init__(self, action_type: int = ..., polygon_name: str = ...) -> None: ...
+
+class ComputeAndTrackRoute(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_Goal"
+        start_id: int
+        start: _geometry_msgs.PoseStamped
+        goal_id: int
+        goal: _geometry_msgs.PoseStamped
+        use_start: bool
+        use_poses: bool
+        def __init__(self, start_id: int = ..., start: _geometry_msgs.PoseStamped | None = ..., goal_id: int = ..., goal: _geometry_msgs.PoseStamped | None = ..., use_start: bool = ..., use_poses: bool = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 400
+        TF_ERROR: Final = 401
+        NO_VALID_GRAPH: Final = 402
+        INDETERMINANT_NODES_ON_GRAPH: Final = 403
+        TIMEOUT: Final = 404
+        NO_VALID_ROUTE: Final = 405
+        OPERATION_FAILED: Final = 406
+        INVALID_EDGE_SCORER_USE: Final = 407
+        execution_duration: _builtin_interfaces.Duration
+        error_code: int
+        def __init__(self, execution_duration: _builtin_interfaces.Duration | None = ..., error_code: int = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_Feedback"
+        last_node_id: int
+        next_node_id: int
+        current_edge_id: int
+        route: Route
+        path: _nav_msgs.Path
+        operations_triggered: list[str]
+        rerouted: bool
+        def __init__(self, last_node_id: int = ..., next_node_id: int = ..., current_edge_id: int = ..., route: Route | None = ..., path: _nav_msgs.Path | None = ..., operations_triggered: Sequence[str] | None = ..., rerouted: bool = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: ComputeAndTrackRoute.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: ComputeAndTrackRoute.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[ComputeAndTrackRoute.SendGoal.Request]
+            response: list[ComputeAndTrackRoute.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ComputeAndTrackRoute.SendGoal.Request] | None = ..., response: Sequence[ComputeAndTrackRoute.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_GetResult_Response"
+            status: int
+            result: ComputeAndTrackRoute.Result
+            def __init__(self, status: int = ..., result: ComputeAndTrackRoute.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[ComputeAndTrackRoute.GetResult.Request]
+            response: list[ComputeAndTrackRoute.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ComputeAndTrackRoute.GetResult.Request] | None = ..., response: Sequence[ComputeAndTrackRoute.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeAndTrackRoute_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: ComputeAndTrackRoute.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: ComputeAndTrackRoute.Feedback | None = ...) -> None: ...
+
+class ComputePathThroughPoses(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_Goal"
+        goals: list[_geometry_msgs.PoseStamped]
+        start: _geometry_msgs.PoseStamped
+        planner_id: str
+        use_start: bool
+        def __init__(self, goals: Sequence[_geometry_msgs.PoseStamped] | None = ..., start: _geometry_msgs.PoseStamped | None = ..., planner_id: str = ..., use_start: bool = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 300
+        INVALID_PLANNER: Final = 301
+        TF_ERROR: Final = 302
+        START_OUTSIDE_MAP: Final = 303
+        GOAL_OUTSIDE_MAP: Final = 304
+        START_OCCUPIED: Final = 305
+        GOAL_OCCUPIED: Final = 306
+        TIMEOUT: Final = 307
+        NO_VALID_PATH: Final = 308
+        NO_VIAPOINTS_GIVEN: Final = 309
+        path: _nav_msgs.Path
+        planning_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, path: _nav_msgs.Path | None = ..., planning_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_Feedback"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: ComputePathThroughPoses.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: ComputePathThroughPoses.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[ComputePathThroughPoses.SendGoal.Request]
+            response: list[ComputePathThroughPoses.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ComputePathThroughPoses.SendGoal.Request] | None = ..., response: Sequence[ComputePathThroughPoses.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_GetResult_Response"
+            status: int
+            result: ComputePathThroughPoses.Result
+            def __init__(self, status: int = ..., result: ComputePathThroughPoses.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[ComputePathThroughPoses.GetResult.Request]
+            response: list[ComputePathThroughPoses.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ComputePathThroughPoses.GetResult.Request] | None = ..., response: Sequence[ComputePathThroughPoses.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathThroughPoses_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: ComputePathThroughPoses.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: ComputePathThroughPoses.Feedback | None = ...) -> None: ...
 
 class ComputePathToPose(Action):
     __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputePathToPose"
@@ -87,6 +464,545 @@ class ComputePathToPose(Action):
         feedback: ComputePathToPose.Feedback
         def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: ComputePathToPose.Feedback | None = ...) -> None: ...
 
+class ComputeRoute(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_Goal"
+        start_id: int
+        start: _geometry_msgs.PoseStamped
+        goal_id: int
+        goal: _geometry_msgs.PoseStamped
+        use_start: bool
+        use_poses: bool
+        def __init__(self, start_id: int = ..., start: _geometry_msgs.PoseStamped | None = ..., goal_id: int = ..., goal: _geometry_msgs.PoseStamped | None = ..., use_start: bool = ..., use_poses: bool = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 400
+        TF_ERROR: Final = 401
+        NO_VALID_GRAPH: Final = 402
+        INDETERMINANT_NODES_ON_GRAPH: Final = 403
+        TIMEOUT: Final = 404
+        NO_VALID_ROUTE: Final = 405
+        INVALID_EDGE_SCORER_USE: Final = 407
+        planning_time: _builtin_interfaces.Duration
+        path: _nav_msgs.Path
+        route: Route
+        error_code: int
+        def __init__(self, planning_time: _builtin_interfaces.Duration | None = ..., path: _nav_msgs.Path | None = ..., route: Route | None = ..., error_code: int = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_Feedback"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: ComputeRoute.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: ComputeRoute.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[ComputeRoute.SendGoal.Request]
+            response: list[ComputeRoute.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ComputeRoute.SendGoal.Request] | None = ..., response: Sequence[ComputeRoute.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_GetResult_Response"
+            status: int
+            result: ComputeRoute.Result
+            def __init__(self, status: int = ..., result: ComputeRoute.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[ComputeRoute.GetResult.Request]
+            response: list[ComputeRoute.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ComputeRoute.GetResult.Request] | None = ..., response: Sequence[ComputeRoute.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/ComputeRoute_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: ComputeRoute.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: ComputeRoute.Feedback | None = ...) -> None: ...
+
+class Costmap(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/Costmap"
+    header: _std_msgs.Header
+    metadata: CostmapMetaData
+    data: NDArray[np.uint8]
+    def __init__(self, header: _std_msgs.Header | None = ..., metadata: CostmapMetaData | None = ..., data: ArrayLike | None = ...) -> None: ...
+
+class CostmapFilterInfo(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/CostmapFilterInfo"
+    header: _std_msgs.Header
+    type: int
+    filter_mask_topic: str
+    base: float
+    multiplier: float
+    def __init__(self, header: _std_msgs.Header | None = ..., type: int = ..., filter_mask_topic: str = ..., base: float = ..., multiplier: float = ...) -> None: ...
+
+class CostmapMetaData(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/CostmapMetaData"
+    map_load_time: _builtin_interfaces.Time
+    update_time: _builtin_interfaces.Time
+    layer: str
+    resolution: float
+    size_x: int
+    size_y: int
+    origin: _geometry_msgs.Pose
+    def __init__(self, map_load_time: _builtin_interfaces.Time | None = ..., update_time: _builtin_interfaces.Time | None = ..., layer: str = ..., resolution: float = ..., size_x: int = ..., size_y: int = ..., origin: _geometry_msgs.Pose | None = ...) -> None: ...
+
+class CostmapUpdate(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/CostmapUpdate"
+    header: _std_msgs.Header
+    x: int
+    y: int
+    size_x: int
+    size_y: int
+    data: NDArray[np.uint8]
+    def __init__(self, header: _std_msgs.Header | None = ..., x: int = ..., y: int = ..., size_x: int = ..., size_y: int = ..., data: ArrayLike | None = ...) -> None: ...
+
+class DockRobot(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_Goal"
+        use_dock_id: bool
+        dock_id: str
+        dock_pose: _geometry_msgs.PoseStamped
+        dock_type: str
+        max_staging_time: float
+        navigate_to_staging_pose: bool
+        def __init__(self, use_dock_id: bool = ..., dock_id: str = ..., dock_pose: _geometry_msgs.PoseStamped | None = ..., dock_type: str = ..., max_staging_time: float = ..., navigate_to_staging_pose: bool = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_Result"
+        NONE: Final = 0
+        DOCK_NOT_IN_DB: Final = 901
+        DOCK_NOT_VALID: Final = 902
+        FAILED_TO_STAGE: Final = 903
+        FAILED_TO_DETECT_DOCK: Final = 904
+        FAILED_TO_CONTROL: Final = 905
+        FAILED_TO_CHARGE: Final = 906
+        UNKNOWN: Final = 999
+        success: bool
+        error_code: int
+        num_retries: int
+        error_msg: str
+        def __init__(self, success: bool = ..., error_code: int = ..., num_retries: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_Feedback"
+        NONE: Final = 0
+        NAV_TO_STAGING_POSE: Final = 1
+        INITIAL_PERCEPTION: Final = 2
+        CONTROLLING: Final = 3
+        WAIT_FOR_CHARGE: Final = 4
+        RETRY: Final = 5
+        state: int
+        docking_time: _builtin_interfaces.Duration
+        num_retries: int
+        def __init__(self, state: int = ..., docking_time: _builtin_interfaces.Duration | None = ..., num_retries: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: DockRobot.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: DockRobot.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[DockRobot.SendGoal.Request]
+            response: list[DockRobot.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DockRobot.SendGoal.Request] | None = ..., response: Sequence[DockRobot.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_GetResult_Response"
+            status: int
+            result: DockRobot.Result
+            def __init__(self, status: int = ..., result: DockRobot.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[DockRobot.GetResult.Request]
+            response: list[DockRobot.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DockRobot.GetResult.Request] | None = ..., response: Sequence[DockRobot.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DockRobot_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: DockRobot.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: DockRobot.Feedback | None = ...) -> None: ...
+
+class DriveOnHeading(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_Goal"
+        target: _geometry_msgs.Point
+        speed: float
+        time_allowance: _builtin_interfaces.Duration
+        def __init__(self, target: _geometry_msgs.Point | None = ..., speed: float = ..., time_allowance: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 720
+        TIMEOUT: Final = 721
+        TF_ERROR: Final = 722
+        COLLISION_AHEAD: Final = 723
+        INVALID_INPUT: Final = 724
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_Feedback"
+        distance_traveled: float
+        def __init__(self, distance_traveled: float = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: DriveOnHeading.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: DriveOnHeading.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[DriveOnHeading.SendGoal.Request]
+            response: list[DriveOnHeading.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DriveOnHeading.SendGoal.Request] | None = ..., response: Sequence[DriveOnHeading.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_GetResult_Response"
+            status: int
+            result: DriveOnHeading.Result
+            def __init__(self, status: int = ..., result: DriveOnHeading.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[DriveOnHeading.GetResult.Request]
+            response: list[DriveOnHeading.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DriveOnHeading.GetResult.Request] | None = ..., response: Sequence[DriveOnHeading.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DriveOnHeading_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: DriveOnHeading.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: DriveOnHeading.Feedback | None = ...) -> None: ...
+
+class DummyBehavior(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_Goal"
+        command: _std_msgs.String
+        def __init__(self, command: _std_msgs.String | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_Result"
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_Feedback"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: DummyBehavior.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: DummyBehavior.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[DummyBehavior.SendGoal.Request]
+            response: list[DummyBehavior.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DummyBehavior.SendGoal.Request] | None = ..., response: Sequence[DummyBehavior.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_GetResult_Response"
+            status: int
+            result: DummyBehavior.Result
+            def __init__(self, status: int = ..., result: DummyBehavior.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[DummyBehavior.GetResult.Request]
+            response: list[DummyBehavior.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DummyBehavior.GetResult.Request] | None = ..., response: Sequence[DummyBehavior.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/DummyBehavior_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: DummyBehavior.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: DummyBehavior.Feedback | None = ...) -> None: ...
+
+class DynamicEdges(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/DynamicEdges"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/DynamicEdges_Request"
+        closed_edges: NDArray[np.uint16]
+        opened_edges: NDArray[np.uint16]
+        adjust_edges: list[EdgeCost]
+        def __init__(self, closed_edges: ArrayLike | None = ..., opened_edges: ArrayLike | None = ..., adjust_edges: Sequence[EdgeCost] | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/DynamicEdges_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/DynamicEdges_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[DynamicEdges.Request]
+        response: list[DynamicEdges.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[DynamicEdges.Request] | None = ..., response: Sequence[DynamicEdges.Response] | None = ...) -> None: ...
+
+class EdgeCost(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/EdgeCost"
+    edgeid: int
+    cost: float
+    def __init__(self, edgeid: int = ..., cost: float = ...) -> None: ...
+
+class FollowGPSWaypoints(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_Goal"
+        number_of_loops: int
+        goal_index: int
+        gps_poses: list[_geographic_msgs.GeoPose]
+        def __init__(self, number_of_loops: int = ..., goal_index: int = ..., gps_poses: Sequence[_geographic_msgs.GeoPose] | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 600
+        TASK_EXECUTOR_FAILED: Final = 601
+        missed_waypoints: list[MissedWaypoint]
+        error_code: int
+        error_msg: str
+        def __init__(self, missed_waypoints: Sequence[MissedWaypoint] | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_Feedback"
+        current_waypoint: int
+        def __init__(self, current_waypoint: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: FollowGPSWaypoints.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: FollowGPSWaypoints.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[FollowGPSWaypoints.SendGoal.Request]
+            response: list[FollowGPSWaypoints.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FollowGPSWaypoints.SendGoal.Request] | None = ..., response: Sequence[FollowGPSWaypoints.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_GetResult_Response"
+            status: int
+            result: FollowGPSWaypoints.Result
+            def __init__(self, status: int = ..., result: FollowGPSWaypoints.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[FollowGPSWaypoints.GetResult.Request]
+            response: list[FollowGPSWaypoints.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FollowGPSWaypoints.GetResult.Request] | None = ..., response: Sequence[FollowGPSWaypoints.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowGPSWaypoints_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: FollowGPSWaypoints.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: FollowGPSWaypoints.Feedback | None = ...) -> None: ...
+
+class FollowObject(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_Goal"
+        pose_topic: str
+        tracked_frame: str
+        max_duration: _builtin_interfaces.Duration
+        def __init__(self, pose_topic: str = ..., tracked_frame: str = ..., max_duration: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_Result"
+        NONE: Final = 0
+        TF_ERROR: Final = 901
+        FAILED_TO_DETECT_OBJECT: Final = 902
+        FAILED_TO_CONTROL: Final = 903
+        TIMEOUT: Final = 904
+        UNKNOWN: Final = 999
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        num_retries: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., num_retries: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_Feedback"
+        NONE: Final = 0
+        INITIAL_PERCEPTION: Final = 1
+        CONTROLLING: Final = 2
+        STOPPING: Final = 3
+        RETRY: Final = 4
+        state: int
+        following_time: _builtin_interfaces.Duration
+        num_retries: int
+        def __init__(self, state: int = ..., following_time: _builtin_interfaces.Duration | None = ..., num_retries: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: FollowObject.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: FollowObject.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[FollowObject.SendGoal.Request]
+            response: list[FollowObject.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FollowObject.SendGoal.Request] | None = ..., response: Sequence[FollowObject.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_GetResult_Response"
+            status: int
+            result: FollowObject.Result
+            def __init__(self, status: int = ..., result: FollowObject.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[FollowObject.GetResult.Request]
+            response: list[FollowObject.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FollowObject.GetResult.Request] | None = ..., response: Sequence[FollowObject.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowObject_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: FollowObject.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: FollowObject.Feedback | None = ...) -> None: ...
+
+class FollowPath(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_Goal"
+        path: _nav_msgs.Path
+        controller_id: str
+        goal_checker_id: str
+        progress_checker_id: str
+        def __init__(self, path: _nav_msgs.Path | None = ..., controller_id: str = ..., goal_checker_id: str = ..., progress_checker_id: str = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 100
+        INVALID_CONTROLLER: Final = 101
+        TF_ERROR: Final = 102
+        INVALID_PATH: Final = 103
+        PATIENCE_EXCEEDED: Final = 104
+        FAILED_TO_MAKE_PROGRESS: Final = 105
+        NO_VALID_CONTROL: Final = 106
+        CONTROLLER_TIMED_OUT: Final = 107
+        result: _std_msgs.Empty
+        error_code: int
+        error_msg: str
+        def __init__(self, result: _std_msgs.Empty | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_Feedback"
+        distance_to_goal: float
+        speed: float
+        def __init__(self, distance_to_goal: float = ..., speed: float = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: FollowPath.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: FollowPath.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[FollowPath.SendGoal.Request]
+            response: list[FollowPath.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FollowPath.SendGoal.Request] | None = ..., response: Sequence[FollowPath.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_GetResult_Response"
+            status: int
+            result: FollowPath.Result
+            def __init__(self, status: int = ..., result: FollowPath.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[FollowPath.GetResult.Request]
+            response: list[FollowPath.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FollowPath.GetResult.Request] | None = ..., response: Sequence[FollowPath.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowPath_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: FollowPath.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: FollowPath.Feedback | None = ...) -> None: ...
+
 class FollowWaypoints(Action):
     __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowWaypoints"
     class Goal(Message):
@@ -101,7 +1017,9 @@ class FollowWaypoints(Action):
         UNKNOWN: Final = 600
         TASK_EXECUTOR_FAILED: Final = 601
         missed_waypoints: list[MissedWaypoint]
-        def __init__(self, missed_waypoints: Sequence[MissedWaypoint] | None = ...) -> None: ...
+        error_code: int
+        error_msg: str
+        def __init__(self, missed_waypoints: Sequence[MissedWaypoint] | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
     class Feedback(Message):
         __msgtype__: ClassVar[str] = "nav2_msgs/action/FollowWaypoints_Feedback"
         current_waypoint: int
@@ -146,6 +1064,108 @@ class FollowWaypoints(Action):
         goal_id: _unique_identifier_msgs.UUID
         feedback: FollowWaypoints.Feedback
         def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: FollowWaypoints.Feedback | None = ...) -> None: ...
+
+class GetCost(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCost"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCost_Request"
+        use_footprint: bool
+        x: float
+        y: float
+        theta: float
+        def __init__(self, use_footprint: bool = ..., x: float = ..., y: float = ..., theta: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCost_Response"
+        cost: float
+        def __init__(self, cost: float = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCost_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[GetCost.Request]
+        response: list[GetCost.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[GetCost.Request] | None = ..., response: Sequence[GetCost.Response] | None = ...) -> None: ...
+
+class GetCostmap(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCostmap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCostmap_Request"
+        specs: CostmapMetaData
+        def __init__(self, specs: CostmapMetaData | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCostmap_Response"
+        map: Costmap
+        def __init__(self, map: Costmap | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/GetCostmap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[GetCostmap.Request]
+        response: list[GetCostmap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[GetCostmap.Request] | None = ..., response: Sequence[GetCostmap.Response] | None = ...) -> None: ...
+
+class IsPathValid(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/IsPathValid"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/IsPathValid_Request"
+        path: _nav_msgs.Path
+        def __init__(self, path: _nav_msgs.Path | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/IsPathValid_Response"
+        is_valid: bool
+        invalid_pose_indices: NDArray[np.int32]
+        def __init__(self, is_valid: bool = ..., invalid_pose_indices: ArrayLike | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/IsPathValid_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[IsPathValid.Request]
+        response: list[IsPathValid.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[IsPathValid.Request] | None = ..., response: Sequence[IsPathValid.Response] | None = ...) -> None: ...
+
+class LoadMap(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/LoadMap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/LoadMap_Request"
+        map_url: str
+        def __init__(self, map_url: str = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/LoadMap_Response"
+        RESULT_SUCCESS: Final = 0
+        RESULT_MAP_DOES_NOT_EXIST: Final = 1
+        RESULT_INVALID_MAP_DATA: Final = 2
+        RESULT_INVALID_MAP_METADATA: Final = 3
+        RESULT_UNDEFINED_FAILURE: Final = 255
+        map: _nav_msgs.OccupancyGrid
+        result: int
+        def __init__(self, map: _nav_msgs.OccupancyGrid | None = ..., result: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/LoadMap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[LoadMap.Request]
+        response: list[LoadMap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[LoadMap.Request] | None = ..., response: Sequence[LoadMap.Response] | None = ...) -> None: ...
+
+class ManageLifecycleNodes(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/ManageLifecycleNodes"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ManageLifecycleNodes_Request"
+        STARTUP: Final = 0
+        PAUSE: Final = 1
+        RESUME: Final = 2
+        RESET: Final = 3
+        SHUTDOWN: Final = 4
+        CONFIGURE: Final = 5
+        CLEANUP: Final = 6
+        command: int
+        def __init__(self, command: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ManageLifecycleNodes_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ManageLifecycleNodes_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[ManageLifecycleNodes.Request]
+        response: list[ManageLifecycleNodes.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ManageLifecycleNodes.Request] | None = ..., response: Sequence[ManageLifecycleNodes.Response] | None = ...) -> None: ...
 
 class MissedWaypoint(Message):
     __msgtype__: ClassVar[str] = "nav2_msgs/msg/MissedWaypoint"
@@ -227,12 +1247,6 @@ class NavigateToPose(Action):
     class Result(Message):
         __msgtype__: ClassVar[str] = "nav2_msgs/action/NavigateToPose_Result"
         NONE: Final = 0
-        GOAL_REJECTED: Final = 1
-        SEND_GOAL_FAILURE: Final = 2
-        UNKNOWN: Final = 9000
-        FAILED_TO_LOAD_BEHAVIOR_TREE: Final = 9001
-        TF_ERROR: Final = 9002
-        TIMEOUT: Final = 9003
         error_code: int
         error_msg: str
         def __init__(self, error_code: int = ..., error_msg: str = ...) -> None: ...
@@ -243,9 +1257,7 @@ class NavigateToPose(Action):
         estimated_time_remaining: _builtin_interfaces.Duration
         number_of_recoveries: int
         distance_remaining: float
-        position_tracking_error: float
-        heading_tracking_error: float
-        def __init__(self, current_pose: _geometry_msgs.PoseStamped | None = ..., navigation_time: _builtin_interfaces.Duration | None = ..., estimated_time_remaining: _builtin_interfaces.Duration | None = ..., number_of_recoveries: int = ..., distance_remaining: float = ..., position_tracking_error: float = ..., heading_tracking_error: float = ...) -> None: ...
+        def __init__(self, current_pose: _geometry_msgs.PoseStamped | None = ..., navigation_time: _builtin_interfaces.Duration | None = ..., estimated_time_remaining: _builtin_interfaces.Duration | None = ..., number_of_recoveries: int = ..., distance_remaining: float = ...) -> None: ...
     class SendGoal(Service):
         __msgtype__: ClassVar[str] = "nav2_msgs/action/NavigateToPose_SendGoal"
         class Request(Message):
@@ -286,3 +1298,396 @@ class NavigateToPose(Action):
         goal_id: _unique_identifier_msgs.UUID
         feedback: NavigateToPose.Feedback
         def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: NavigateToPose.Feedback | None = ...) -> None: ...
+
+class Particle(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/Particle"
+    pose: _geometry_msgs.Pose
+    weight: float
+    def __init__(self, pose: _geometry_msgs.Pose | None = ..., weight: float = ...) -> None: ...
+
+class ParticleCloud(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/ParticleCloud"
+    header: _std_msgs.Header
+    particles: list[Particle]
+    def __init__(self, header: _std_msgs.Header | None = ..., particles: Sequence[Particle] | None = ...) -> None: ...
+
+class ReloadDockDatabase(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/ReloadDockDatabase"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ReloadDockDatabase_Request"
+        filepath: str
+        def __init__(self, filepath: str = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ReloadDockDatabase_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/ReloadDockDatabase_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[ReloadDockDatabase.Request]
+        response: list[ReloadDockDatabase.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[ReloadDockDatabase.Request] | None = ..., response: Sequence[ReloadDockDatabase.Response] | None = ...) -> None: ...
+
+class Route(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/Route"
+    header: _std_msgs.Header
+    route_cost: float
+    nodes: list[RouteNode]
+    edges: list[RouteEdge]
+    def __init__(self, header: _std_msgs.Header | None = ..., route_cost: float = ..., nodes: Sequence[RouteNode] | None = ..., edges: Sequence[RouteEdge] | None = ...) -> None: ...
+
+class RouteEdge(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/RouteEdge"
+    edgeid: int
+    start: _geometry_msgs.Point
+    end: _geometry_msgs.Point
+    def __init__(self, edgeid: int = ..., start: _geometry_msgs.Point | None = ..., end: _geometry_msgs.Point | None = ...) -> None: ...
+
+class RouteNode(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/RouteNode"
+    nodeid: int
+    position: _geometry_msgs.Point
+    def __init__(self, nodeid: int = ..., position: _geometry_msgs.Point | None = ...) -> None: ...
+
+class SaveMap(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/SaveMap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SaveMap_Request"
+        map_topic: str
+        map_url: str
+        image_format: str
+        map_mode: str
+        free_thresh: float
+        occupied_thresh: float
+        def __init__(self, map_topic: str = ..., map_url: str = ..., image_format: str = ..., map_mode: str = ..., free_thresh: float = ..., occupied_thresh: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SaveMap_Response"
+        result: bool
+        def __init__(self, result: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SaveMap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SaveMap.Request]
+        response: list[SaveMap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SaveMap.Request] | None = ..., response: Sequence[SaveMap.Response] | None = ...) -> None: ...
+
+class SetInitialPose(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetInitialPose"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetInitialPose_Request"
+        pose: _geometry_msgs.PoseWithCovarianceStamped
+        def __init__(self, pose: _geometry_msgs.PoseWithCovarianceStamped | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetInitialPose_Response"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetInitialPose_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SetInitialPose.Request]
+        response: list[SetInitialPose.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SetInitialPose.Request] | None = ..., response: Sequence[SetInitialPose.Response] | None = ...) -> None: ...
+
+class SetRouteGraph(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetRouteGraph"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetRouteGraph_Request"
+        graph_filepath: str
+        def __init__(self, graph_filepath: str = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetRouteGraph_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/SetRouteGraph_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SetRouteGraph.Request]
+        response: list[SetRouteGraph.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SetRouteGraph.Request] | None = ..., response: Sequence[SetRouteGraph.Response] | None = ...) -> None: ...
+
+class SmoothPath(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_Goal"
+        path: _nav_msgs.Path
+        smoother_id: str
+        max_smoothing_duration: _builtin_interfaces.Duration
+        check_for_collisions: bool
+        def __init__(self, path: _nav_msgs.Path | None = ..., smoother_id: str = ..., max_smoothing_duration: _builtin_interfaces.Duration | None = ..., check_for_collisions: bool = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 500
+        INVALID_SMOOTHER: Final = 501
+        TIMEOUT: Final = 502
+        SMOOTHED_PATH_IN_COLLISION: Final = 503
+        FAILED_TO_SMOOTH_PATH: Final = 504
+        INVALID_PATH: Final = 505
+        path: _nav_msgs.Path
+        smoothing_duration: _builtin_interfaces.Duration
+        was_completed: bool
+        error_code: int
+        error_msg: str
+        def __init__(self, path: _nav_msgs.Path | None = ..., smoothing_duration: _builtin_interfaces.Duration | None = ..., was_completed: bool = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_Feedback"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: SmoothPath.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: SmoothPath.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[SmoothPath.SendGoal.Request]
+            response: list[SmoothPath.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SmoothPath.SendGoal.Request] | None = ..., response: Sequence[SmoothPath.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_GetResult_Response"
+            status: int
+            result: SmoothPath.Result
+            def __init__(self, status: int = ..., result: SmoothPath.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[SmoothPath.GetResult.Request]
+            response: list[SmoothPath.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SmoothPath.GetResult.Request] | None = ..., response: Sequence[SmoothPath.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/SmoothPath_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: SmoothPath.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: SmoothPath.Feedback | None = ...) -> None: ...
+
+class SpeedLimit(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/SpeedLimit"
+    header: _std_msgs.Header
+    percentage: bool
+    speed_limit: float
+    def __init__(self, header: _std_msgs.Header | None = ..., percentage: bool = ..., speed_limit: float = ...) -> None: ...
+
+class Spin(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_Goal"
+        target_yaw: float
+        time_allowance: _builtin_interfaces.Duration
+        def __init__(self, target_yaw: float = ..., time_allowance: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_Result"
+        NONE: Final = 0
+        UNKNOWN: Final = 700
+        TIMEOUT: Final = 701
+        TF_ERROR: Final = 702
+        COLLISION_AHEAD: Final = 703
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_Feedback"
+        angular_distance_traveled: float
+        def __init__(self, angular_distance_traveled: float = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: Spin.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: Spin.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[Spin.SendGoal.Request]
+            response: list[Spin.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Spin.SendGoal.Request] | None = ..., response: Sequence[Spin.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_GetResult_Response"
+            status: int
+            result: Spin.Result
+            def __init__(self, status: int = ..., result: Spin.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[Spin.GetResult.Request]
+            response: list[Spin.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Spin.GetResult.Request] | None = ..., response: Sequence[Spin.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Spin_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: Spin.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: Spin.Feedback | None = ...) -> None: ...
+
+class Toggle(Service):
+    __msgtype__: ClassVar[str] = "nav2_msgs/srv/Toggle"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/Toggle_Request"
+        enable: bool
+        def __init__(self, enable: bool = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/Toggle_Response"
+        success: bool
+        message: str
+        def __init__(self, success: bool = ..., message: str = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/srv/Toggle_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Toggle.Request]
+        response: list[Toggle.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Toggle.Request] | None = ..., response: Sequence[Toggle.Response] | None = ...) -> None: ...
+
+class UndockRobot(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_Goal"
+        dock_type: str
+        max_undocking_time: float
+        def __init__(self, dock_type: str = ..., max_undocking_time: float = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_Result"
+        NONE: Final = 0
+        DOCK_NOT_VALID: Final = 902
+        FAILED_TO_CONTROL: Final = 905
+        UNKNOWN: Final = 999
+        success: bool
+        error_code: int
+        error_msg: str
+        def __init__(self, success: bool = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_Feedback"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: UndockRobot.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: UndockRobot.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[UndockRobot.SendGoal.Request]
+            response: list[UndockRobot.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[UndockRobot.SendGoal.Request] | None = ..., response: Sequence[UndockRobot.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_GetResult_Response"
+            status: int
+            result: UndockRobot.Result
+            def __init__(self, status: int = ..., result: UndockRobot.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[UndockRobot.GetResult.Request]
+            response: list[UndockRobot.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[UndockRobot.GetResult.Request] | None = ..., response: Sequence[UndockRobot.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/UndockRobot_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: UndockRobot.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: UndockRobot.Feedback | None = ...) -> None: ...
+
+class VoxelGrid(Message):
+    __msgtype__: ClassVar[str] = "nav2_msgs/msg/VoxelGrid"
+    header: _std_msgs.Header
+    data: NDArray[np.uint32]
+    origin: _geometry_msgs.Point32
+    resolutions: _geometry_msgs.Vector3
+    size_x: int
+    size_y: int
+    size_z: int
+    def __init__(self, header: _std_msgs.Header | None = ..., data: ArrayLike | None = ..., origin: _geometry_msgs.Point32 | None = ..., resolutions: _geometry_msgs.Vector3 | None = ..., size_x: int = ..., size_y: int = ..., size_z: int = ...) -> None: ...
+
+class Wait(Action):
+    __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_Goal"
+        time: _builtin_interfaces.Duration
+        def __init__(self, time: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_Result"
+        total_elapsed_time: _builtin_interfaces.Duration
+        error_code: int
+        error_msg: str
+        def __init__(self, total_elapsed_time: _builtin_interfaces.Duration | None = ..., error_code: int = ..., error_msg: str = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_Feedback"
+        time_left: _builtin_interfaces.Duration
+        def __init__(self, time_left: _builtin_interfaces.Duration | None = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: Wait.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: Wait.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[Wait.SendGoal.Request]
+            response: list[Wait.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Wait.SendGoal.Request] | None = ..., response: Sequence[Wait.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_GetResult_Response"
+            status: int
+            result: Wait.Result
+            def __init__(self, status: int = ..., result: Wait.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[Wait.GetResult.Request]
+            response: list[Wait.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Wait.GetResult.Request] | None = ..., response: Sequence[Wait.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "nav2_msgs/action/Wait_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: Wait.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: Wait.Feedback | None = ...) -> None: ...

@@ -11,11 +11,15 @@ from typing import Any
 from ._package import package_getattr
 
 __all__ = [
+    "GetMap",
+    "GetPlan",
     "GridCells",
+    "LoadMap",
     "MapMetaData",
     "OccupancyGrid",
     "Odometry",
     "Path",
+    "SetMap",
 ]
 
 

@@ -9,10 +9,47 @@ from numpy.typing import ArrayLike, NDArray
 from aiorobot.msgs import Action, Message, Service
 from aiorobot.msgs import builtin_interfaces as _builtin_interfaces
 from aiorobot.msgs import geometry_msgs as _geometry_msgs
+from aiorobot.msgs import service_msgs as _service_msgs
 from aiorobot.msgs import std_msgs as _std_msgs
 
-__all__ = ['GridCells', 'MapMetaData', 'OccupancyGrid', 'Odometry', 'Path']
+__all__ = ['GetMap', 'GetPlan', 'GridCells', 'LoadMap', 'MapMetaData', 'OccupancyGrid', 'Odometry', 'Path', 'SetMap']
 
+
+class GetMap(Service):
+    __msgtype__: ClassVar[str] = "nav_msgs/srv/GetMap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/GetMap_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/GetMap_Response"
+        map: OccupancyGrid
+        def __init__(self, map: OccupancyGrid | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/GetMap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[GetMap.Request]
+        response: list[GetMap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[GetMap.Request] | None = ..., response: Sequence[GetMap.Response] | None = ...) -> None: ...
+
+class GetPlan(Service):
+    __msgtype__: ClassVar[str] = "nav_msgs/srv/GetPlan"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/GetPlan_Request"
+        start: _geometry_msgs.PoseStamped
+        goal: _geometry_msgs.PoseStamped
+        tolerance: float
+        def __init__(self, start: _geometry_msgs.PoseStamped | None = ..., goal: _geometry_msgs.PoseStamped | None = ..., tolerance: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/GetPlan_Response"
+        plan: Path
+        def __init__(self, plan: Path | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/GetPlan_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[GetPlan.Request]
+        response: list[GetPlan.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[GetPlan.Request] | None = ..., response: Sequence[GetPlan.Response] | None = ...) -> None: ...
 
 class GridCells(Message):
     __msgtype__: ClassVar[str] = "nav_msgs/msg/GridCells"
@@ -21,6 +58,29 @@ class GridCells(Message):
     cell_height: float
     cells: list[_geometry_msgs.Point]
     def __init__(self, header: _std_msgs.Header | None = ..., cell_width: float = ..., cell_height: float = ..., cells: Sequence[_geometry_msgs.Point] | None = ...) -> None: ...
+
+class LoadMap(Service):
+    __msgtype__: ClassVar[str] = "nav_msgs/srv/LoadMap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/LoadMap_Request"
+        map_url: str
+        def __init__(self, map_url: str = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/LoadMap_Response"
+        RESULT_SUCCESS: Final = 0
+        RESULT_MAP_DOES_NOT_EXIST: Final = 1
+        RESULT_INVALID_MAP_DATA: Final = 2
+        RESULT_INVALID_MAP_METADATA: Final = 3
+        RESULT_UNDEFINED_FAILURE: Final = 255
+        map: OccupancyGrid
+        result: int
+        def __init__(self, map: OccupancyGrid | None = ..., result: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/LoadMap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[LoadMap.Request]
+        response: list[LoadMap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[LoadMap.Request] | None = ..., response: Sequence[LoadMap.Response] | None = ...) -> None: ...
 
 class MapMetaData(Message):
     __msgtype__: ClassVar[str] = "nav_msgs/msg/MapMetaData"
@@ -51,3 +111,21 @@ class Path(Message):
     header: _std_msgs.Header
     poses: list[_geometry_msgs.PoseStamped]
     def __init__(self, header: _std_msgs.Header | None = ..., poses: Sequence[_geometry_msgs.PoseStamped] | None = ...) -> None: ...
+
+class SetMap(Service):
+    __msgtype__: ClassVar[str] = "nav_msgs/srv/SetMap"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/SetMap_Request"
+        map: OccupancyGrid
+        initial_pose: _geometry_msgs.PoseWithCovarianceStamped
+        def __init__(self, map: OccupancyGrid | None = ..., initial_pose: _geometry_msgs.PoseWithCovarianceStamped | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/SetMap_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "nav_msgs/srv/SetMap_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SetMap.Request]
+        response: list[SetMap.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SetMap.Request] | None = ..., response: Sequence[SetMap.Response] | None = ...) -> None: ...

@@ -11,7 +11,20 @@ from typing import Any
 from ._package import package_getattr
 
 __all__ = [
+    "Burst",
+    "GetRate",
+    "IsPaused",
+    "Pause",
+    "Play",
+    "PlayNext",
     "ReadSplitEvent",
+    "Resume",
+    "Seek",
+    "SetRate",
+    "Snapshot",
+    "SplitBagfile",
+    "Stop",
+    "TogglePaused",
     "WriteSplitEvent",
 ]
 

@@ -7,9 +7,115 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aiorobot.msgs import Action, Message, Service
+from aiorobot.msgs import builtin_interfaces as _builtin_interfaces
+from aiorobot.msgs import service_msgs as _service_msgs
 
-__all__ = ['ReadSplitEvent', 'WriteSplitEvent']
+__all__ = ['Burst', 'GetRate', 'IsPaused', 'Pause', 'Play', 'PlayNext', 'ReadSplitEvent', 'Resume', 'Seek', 'SetRate', 'Snapshot', 'SplitBagfile', 'Stop', 'TogglePaused', 'WriteSplitEvent']
 
+
+class Burst(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Burst"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Burst_Request"
+        num_messages: int
+        def __init__(self, num_messages: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Burst_Response"
+        actually_burst: int
+        def __init__(self, actually_burst: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Burst_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Burst.Request]
+        response: list[Burst.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Burst.Request] | None = ..., response: Sequence[Burst.Response] | None = ...) -> None: ...
+
+class GetRate(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/GetRate"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/GetRate_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/GetRate_Response"
+        rate: float
+        def __init__(self, rate: float = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/GetRate_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[GetRate.Request]
+        response: list[GetRate.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[GetRate.Request] | None = ..., response: Sequence[GetRate.Response] | None = ...) -> None: ...
+
+class IsPaused(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/IsPaused"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/IsPaused_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/IsPaused_Response"
+        paused: bool
+        def __init__(self, paused: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/IsPaused_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[IsPaused.Request]
+        response: list[IsPaused.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[IsPaused.Request] | None = ..., response: Sequence[IsPaused.Response] | None = ...) -> None: ...
+
+class Pause(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Pause"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Pause_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Pause_Response"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Pause_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Pause.Request]
+        response: list[Pause.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Pause.Request] | None = ..., response: Sequence[Pause.Response] | None = ...) -> None: ...
+
+class Play(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Play"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Play_Request"
+        start_offset: _builtin_interfaces.Time
+        playback_duration: _builtin_interfaces.Duration
+        playback_until_timestamp: _builtin_interfaces.Time
+        def __init__(self, start_offset: _builtin_interfaces.Time | None = ..., playback_duration: _builtin_interfaces.Duration | None = ..., playback_until_timestamp: _builtin_interfaces.Time | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Play_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Play_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Play.Request]
+        response: list[Play.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Play.Request] | None = ..., response: Sequence[Play.Response] | None = ...) -> None: ...
+
+class PlayNext(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/PlayNext"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/PlayNext_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/PlayNext_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/PlayNext_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[PlayNext.Request]
+        response: list[PlayNext.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[PlayNext.Request] | None = ..., response: Sequence[PlayNext.Response] | None = ...) -> None: ...
 
 class ReadSplitEvent(Message):
     __msgtype__: ClassVar[str] = "rosbag2_interfaces/msg/ReadSplitEvent"
@@ -17,6 +123,125 @@ class ReadSplitEvent(Message):
     opened_file: str
     node_name: str
     def __init__(self, closed_file: str = ..., opened_file: str = ..., node_name: str = ...) -> None: ...
+
+class Resume(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Resume"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Resume_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Resume_Response"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Resume_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Resume.Request]
+        response: list[Resume.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Resume.Request] | None = ..., response: Sequence[Resume.Response] | None = ...) -> None: ...
+
+class Seek(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Seek"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Seek_Request"
+        time: _builtin_interfaces.Time
+        def __init__(self, time: _builtin_interfaces.Time | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Seek_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Seek_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Seek.Request]
+        response: list[Seek.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Seek.Request] | None = ..., response: Sequence[Seek.Response] | None = ...) -> None: ...
+
+class SetRate(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SetRate"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SetRate_Request"
+        rate: float
+        def __init__(self, rate: float = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SetRate_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SetRate_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SetRate.Request]
+        response: list[SetRate.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SetRate.Request] | None = ..., response: Sequence[SetRate.Response] | None = ...) -> None: ...
+
+class Snapshot(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Snapshot"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Snapshot_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Snapshot_Response"
+        success: bool
+        def __init__(self, success: bool = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Snapshot_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Snapshot.Request]
+        response: list[Snapshot.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Snapshot.Request] | None = ..., response: Sequence[Snapshot.Response] | None = ...) -> None: ...
+
+class SplitBagfile(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SplitBagfile"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SplitBagfile_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SplitBagfile_Response"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/SplitBagfile_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SplitBagfile.Request]
+        response: list[SplitBagfile.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SplitBagfile.Request] | None = ..., response: Sequence[SplitBagfile.Response] | None = ...) -> None: ...
+
+class Stop(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Stop"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Stop_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Stop_Response"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/Stop_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[Stop.Request]
+        response: list[Stop.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[Stop.Request] | None = ..., response: Sequence[Stop.Response] | None = ...) -> None: ...
+
+class TogglePaused(Service):
+    __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/TogglePaused"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/TogglePaused_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/TogglePaused_Response"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "rosbag2_interfaces/srv/TogglePaused_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[TogglePaused.Request]
+        response: list[TogglePaused.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[TogglePaused.Request] | None = ..., response: Sequence[TogglePaused.Response] | None = ...) -> None: ...
 
 class WriteSplitEvent(Message):
     __msgtype__: ClassVar[str] = "rosbag2_interfaces/msg/WriteSplitEvent"

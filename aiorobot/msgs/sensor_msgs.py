@@ -36,6 +36,7 @@ __all__ = [
     "Range",
     "RegionOfInterest",
     "RelativeHumidity",
+    "SetCameraInfo",
     "Temperature",
     "TimeReference",
 ]

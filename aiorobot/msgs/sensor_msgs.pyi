@@ -9,9 +9,10 @@ from numpy.typing import ArrayLike, NDArray
 from aiorobot.msgs import Action, Message, Service
 from aiorobot.msgs import builtin_interfaces as _builtin_interfaces
 from aiorobot.msgs import geometry_msgs as _geometry_msgs
+from aiorobot.msgs import service_msgs as _service_msgs
 from aiorobot.msgs import std_msgs as _std_msgs
 
-__all__ = ['BatteryState', 'CameraInfo', 'ChannelFloat32', 'CompressedImage', 'FluidPressure', 'Illuminance', 'Image', 'Imu', 'JointState', 'Joy', 'JoyFeedback', 'JoyFeedbackArray', 'LaserEcho', 'LaserScan', 'MagneticField', 'MultiDOFJointState', 'MultiEchoLaserScan', 'NavSatFix', 'NavSatStatus', 'PointCloud', 'PointCloud2', 'PointField', 'Range', 'RegionOfInterest', 'RelativeHumidity', 'Temperature', 'TimeReference']
+__all__ = ['BatteryState', 'CameraInfo', 'ChannelFloat32', 'CompressedImage', 'FluidPressure', 'Illuminance', 'Image', 'Imu', 'JointState', 'Joy', 'JoyFeedback', 'JoyFeedbackArray', 'LaserEcho', 'LaserScan', 'MagneticField', 'MultiDOFJointState', 'MultiEchoLaserScan', 'NavSatFix', 'NavSatStatus', 'PointCloud', 'PointCloud2', 'PointField', 'Range', 'RegionOfInterest', 'RelativeHumidity', 'SetCameraInfo', 'Temperature', 'TimeReference']
 
 
 class BatteryState(Message):
@@ -296,6 +297,24 @@ class RelativeHumidity(Message):
     relative_humidity: float
     variance: float
     def __init__(self, header: _std_msgs.Header | None = ..., relative_humidity: float = ..., variance: float = ...) -> None: ...
+
+class SetCameraInfo(Service):
+    __msgtype__: ClassVar[str] = "sensor_msgs/srv/SetCameraInfo"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "sensor_msgs/srv/SetCameraInfo_Request"
+        camera_info: CameraInfo
+        def __init__(self, camera_info: CameraInfo | None = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "sensor_msgs/srv/SetCameraInfo_Response"
+        success: bool
+        status_message: str
+        def __init__(self, success: bool = ..., status_message: str = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "sensor_msgs/srv/SetCameraInfo_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[SetCameraInfo.Request]
+        response: list[SetCameraInfo.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[SetCameraInfo.Request] | None = ..., response: Sequence[SetCameraInfo.Response] | None = ...) -> None: ...
 
 class Temperature(Message):
     __msgtype__: ClassVar[str] = "sensor_msgs/msg/Temperature"

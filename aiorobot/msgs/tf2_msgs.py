@@ -11,6 +11,8 @@ from typing import Any
 from ._package import package_getattr
 
 __all__ = [
+    "FrameGraph",
+    "LookupTransform",
     "TF2Error",
     "TFMessage",
 ]

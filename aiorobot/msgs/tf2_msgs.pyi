@@ -7,10 +7,92 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aiorobot.msgs import Action, Message, Service
+from aiorobot.msgs import builtin_interfaces as _builtin_interfaces
 from aiorobot.msgs import geometry_msgs as _geometry_msgs
+from aiorobot.msgs import service_msgs as _service_msgs
+from aiorobot.msgs import unique_identifier_msgs as _unique_identifier_msgs
 
-__all__ = ['TF2Error', 'TFMessage']
+__all__ = ['FrameGraph', 'LookupTransform', 'TF2Error', 'TFMessage']
 
+
+class FrameGraph(Service):
+    __msgtype__: ClassVar[str] = "tf2_msgs/srv/FrameGraph"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/srv/FrameGraph_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/srv/FrameGraph_Response"
+        frame_yaml: str
+        def __init__(self, frame_yaml: str = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/srv/FrameGraph_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[FrameGraph.Request]
+        response: list[FrameGraph.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[FrameGraph.Request] | None = ..., response: Sequence[FrameGraph.Response] | None = ...) -> None: ...
+
+class LookupTransform(Action):
+    __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform"
+    class Goal(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_Goal"
+        target_frame: str
+        source_frame: str
+        source_time: _builtin_interfaces.Time
+        timeout: _builtin_interfaces.Duration
+        target_time: _builtin_interfaces.Time
+        fixed_frame: str
+        advanced: bool
+        def __init__(self, target_frame: str = ..., source_frame: str = ..., source_time: _builtin_interfaces.Time | None = ..., timeout: _builtin_interfaces.Duration | None = ..., target_time: _builtin_interfaces.Time | None = ..., fixed_frame: str = ..., advanced: bool = ...) -> None: ...
+    class Result(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_Result"
+        transform: _geometry_msgs.TransformStamped
+        error: TF2Error
+        def __init__(self, transform: _geometry_msgs.TransformStamped | None = ..., error: TF2Error | None = ...) -> None: ...
+    class Feedback(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_Feedback"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class SendGoal(Service):
+        __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_SendGoal"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_SendGoal_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            goal: LookupTransform.Goal
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., goal: LookupTransform.Goal | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_SendGoal_Response"
+            accepted: bool
+            stamp: _builtin_interfaces.Time
+            def __init__(self, accepted: bool = ..., stamp: _builtin_interfaces.Time | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_SendGoal_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[LookupTransform.SendGoal.Request]
+            response: list[LookupTransform.SendGoal.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[LookupTransform.SendGoal.Request] | None = ..., response: Sequence[LookupTransform.SendGoal.Response] | None = ...) -> None: ...
+    class GetResult(Service):
+        __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_GetResult"
+        class Request(Message):
+            __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_GetResult_Request"
+            goal_id: _unique_identifier_msgs.UUID
+            def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ...) -> None: ...
+        class Response(Message):
+            __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_GetResult_Response"
+            status: int
+            result: LookupTransform.Result
+            def __init__(self, status: int = ..., result: LookupTransform.Result | None = ...) -> None: ...
+        class Event(Message):
+            __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_GetResult_Event"
+            info: _service_msgs.ServiceEventInfo
+            request: list[LookupTransform.GetResult.Request]
+            response: list[LookupTransform.GetResult.Response]
+            def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[LookupTransform.GetResult.Request] | None = ..., response: Sequence[LookupTransform.GetResult.Response] | None = ...) -> None: ...
+    class FeedbackMessage(Message):
+        __msgtype__: ClassVar[str] = "tf2_msgs/action/LookupTransform_FeedbackMessage"
+        goal_id: _unique_identifier_msgs.UUID
+        feedback: LookupTransform.Feedback
+        def __init__(self, goal_id: _unique_identifier_msgs.UUID | None = ..., feedback: LookupTransform.Feedback | None = ...) -> None: ...
 
 class TF2Error(Message):
     __msgtype__: ClassVar[str] = "tf2_msgs/msg/TF2Error"

@@ -11,6 +11,7 @@ from typing import Any
 from ._package import package_getattr
 
 __all__ = [
+    "GetInteractiveMarkers",
     "ImageMarker",
     "InteractiveMarker",
     "InteractiveMarkerControl",

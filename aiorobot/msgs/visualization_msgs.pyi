@@ -10,10 +10,29 @@ from aiorobot.msgs import Action, Message, Service
 from aiorobot.msgs import builtin_interfaces as _builtin_interfaces
 from aiorobot.msgs import geometry_msgs as _geometry_msgs
 from aiorobot.msgs import sensor_msgs as _sensor_msgs
+from aiorobot.msgs import service_msgs as _service_msgs
 from aiorobot.msgs import std_msgs as _std_msgs
 
-__all__ = ['ImageMarker', 'InteractiveMarker', 'InteractiveMarkerControl', 'InteractiveMarkerFeedback', 'InteractiveMarkerInit', 'InteractiveMarkerPose', 'InteractiveMarkerUpdate', 'Marker', 'MarkerArray', 'MenuEntry', 'MeshFile', 'UVCoordinate']
+__all__ = ['GetInteractiveMarkers', 'ImageMarker', 'InteractiveMarker', 'InteractiveMarkerControl', 'InteractiveMarkerFeedback', 'InteractiveMarkerInit', 'InteractiveMarkerPose', 'InteractiveMarkerUpdate', 'Marker', 'MarkerArray', 'MenuEntry', 'MeshFile', 'UVCoordinate']
 
+
+class GetInteractiveMarkers(Service):
+    __msgtype__: ClassVar[str] = "visualization_msgs/srv/GetInteractiveMarkers"
+    class Request(Message):
+        __msgtype__: ClassVar[str] = "visualization_msgs/srv/GetInteractiveMarkers_Request"
+        structure_needs_at_least_one_member: int
+        def __init__(self, structure_needs_at_least_one_member: int = ...) -> None: ...
+    class Response(Message):
+        __msgtype__: ClassVar[str] = "visualization_msgs/srv/GetInteractiveMarkers_Response"
+        sequence_number: int
+        markers: list[InteractiveMarker]
+        def __init__(self, sequence_number: int = ..., markers: Sequence[InteractiveMarker] | None = ...) -> None: ...
+    class Event(Message):
+        __msgtype__: ClassVar[str] = "visualization_msgs/srv/GetInteractiveMarkers_Event"
+        info: _service_msgs.ServiceEventInfo
+        request: list[GetInteractiveMarkers.Request]
+        response: list[GetInteractiveMarkers.Response]
+        def __init__(self, info: _service_msgs.ServiceEventInfo | None = ..., request: Sequence[GetInteractiveMarkers.Request] | None = ..., response: Sequence[GetInteractiveMarkers.Response] | None = ...) -> None: ...
 
 class ImageMarker(Message):
     __msgtype__: ClassVar[str] = "visualization_msgs/msg/ImageMarker"

@@ -42,7 +42,8 @@ def test_list_and_package_use_ros2_interface_layout(capsys: pytest.CaptureFixtur
     lines = out.splitlines()
     assert code == 0 and lines[0] == "Messages:" and "    geometry_msgs/msg/Twist" in lines
     assert lines.index("Services:") < lines.index("    std_srvs/srv/Trigger") < lines.index("Actions:")
-    assert lines[lines.index("Actions:") + 1] == "    example_interfaces/action/Fibonacci"
+    assert lines[lines.index("Actions:") + 1] == "    action_tutorials_interfaces/action/Fibonacci"
+    assert "    example_interfaces/action/Fibonacci" in lines[lines.index("Actions:"):]
     assert run(capsys, "package", "std_srvs")[1] == "std_srvs/srv/Empty\nstd_srvs/srv/SetBool\nstd_srvs/srv/Trigger\n"
     assert run(capsys, "package", "example_interfaces", "-a")[1] == "example_interfaces/action/Fibonacci\n"
     assert "geometry_msgs" in run(capsys, "packages")[1].splitlines()
