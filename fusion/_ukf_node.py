@@ -14,6 +14,9 @@ class UkfNode(EkfNode):
     """robot_localization's ``ukf_node``: the inputs, timeline, outputs, tf, services and parameters
     of :class:`EkfNode`, plus ukf_node's ``alpha`` (0.001), ``kappa`` (0) and ``beta`` (2), on a
     :class:`Ukf` core. robot_localization's ukf.yaml loads as it is (``--params-file``).
+
+    rclpy difference: as :class:`EkfNode`; the correction wraps the angle members of the state
+    difference, where ukf.cpp wraps it at the measurement's position (docs/rclpy-differences.md).
     """
 
     _OTHER_FILTER_PARAMETERS: tuple[str, ...] = ()
