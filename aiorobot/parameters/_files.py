@@ -93,7 +93,10 @@ class ParameterFile:
 def load_parameter_file(path: str | Path) -> ParameterFile:
     """Read a ROS 2 parameter file with rcl's scalar types (``1e-9`` is a double; see
     :mod:`aiorobot.parameters._rcl_yaml`); ``FileNotFoundError`` when missing, ``ParameterFileError``
-    when malformed."""
+    when malformed.
+
+    rclpy difference: a list mixing integers and doubles is a double array (rcl refuses it).
+    """
     import yaml
 
     text = Path(path).read_text(encoding="utf-8")
