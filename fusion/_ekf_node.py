@@ -110,6 +110,10 @@ class EkfNode(Node):
             self._tf = TransformBroadcaster(self)
         for input_name, kind in input_names(given):
             self._add_input(input_name, kind)
+        if self.inputs:
+            log.info(f"fusing {', '.join(f'{c.name} ({c.kind} on {c.topic})' for c in self.inputs)}")
+        else:
+            log.warning("no input given (odom0, imu0, pose0, twist0, ...): the filter has nothing to fuse")
         self._wire_services()
         self.create_timer(1.0 / self.frequency, self._on_period)
         if self.print_diagnostics:

@@ -152,3 +152,32 @@ def test_a_generic_node_reads_file_and_dash_p_values_like_code_values(tmp_path):
         assert node.declare_parameter("gains", [0.0]).value == [1e-3, 0.3]
         assert node.declare_parameter("rate", 1.0).value == 100.0
         assert node.get_parameter_overrides() == {"gains": [1e-3, 0.3], "rate": 100.0}
+
+
+def test_aiorobot_run_with_a_parameter_file_says_what_it_fuses_and_what_has_no_effect(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    path = tmp_path / "ukf.yaml"
+    path.write_text(
+        "ukf_filter_node:\n  ros__parameters:\n    debug: false\n    odom0: example/odom\n"
+        f"    odom0_config: {_yaml(ODOM)}\n    initial_estimate_covariance: {_yaml([1e-9] * 15)}\n"
+        "    alpha: 0.001\n    kappa: 0.0\n    beta: 2.0\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONWARNINGS"}
+    done = subprocess.run(
+        [sys.executable, "-m", "aiorobot.cli", "run", "aiorobot.fusion:UkfNode", "--duration", "0.1",
+         "--ros-args", "--params-file", str(path)],
+        capture_output=True, text=True, timeout=120, env=env,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "[/ukf_filter_node]: robot_localization parameter 'debug' has no effect in aiorobot" in done.stderr
+    assert "[/ukf_filter_node]: fusing odom0 (odom on example/odom)" in done.stderr
+    assert "Traceback" not in done.stderr and "alpha" not in done.stderr
+
+
+def test_a_filter_without_inputs_says_so(caplog):
+    with caplog.at_level(logging.WARNING):
+        EkfNode(parameter_overrides={"frequency": 10.0})
+    assert "no input given (odom0, imu0, pose0, twist0, ...): the filter has nothing to fuse" in caplog.text
