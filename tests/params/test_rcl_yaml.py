@@ -138,3 +138,18 @@ def test_overrides_apply_in_command_line_order(tmp_path):
     # node-targeted -p rules form the section "/<name>", as rcl: they reach the node of that fully qualified name
     targeted = Node("my_node", cli_args=["--ros-args", "-p", "my_node:initial_baz:=4.5", "-p", "other:initial_baz:=9.0"])
     assert targeted.declare_parameter("initial_baz", 0.0).value == 4.5
+
+
+def test_special_floats_as_rcl_test_parse_yaml_special_float_point(tmp_path):
+    # rcl_yaml_param_parser test_parse_yaml.cpp special_float_point (its special_float.yaml constructs)
+    path = tmp_path / "special_float.yaml"
+    path.write_text(
+        "test_node:\n  ros__parameters:\n"
+        "    isstring: [string, .nananan, .nAN, .Nan, .infinf, .INf, .infinity]\n"
+        "    nan_inf: [1.1, 2.2, .nan, .NAN, .inf, +.Inf, -.INF]\n"
+    )
+    values = load_parameter_file(path).for_node("/test_node")
+    assert values["isstring"] == ["string", ".nananan", ".nAN", ".Nan", ".infinf", ".INf", ".infinity"]
+    nan_inf = values["nan_inf"]
+    assert nan_inf[:2] == [1.1, 2.2] and math.isnan(nan_inf[2]) and math.isnan(nan_inf[3])
+    assert nan_inf[4:] == [math.inf, math.inf, -math.inf]
