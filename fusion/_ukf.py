@@ -28,7 +28,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._ekf import _REASONS, DEFAULT_PROCESS_NOISE, STATE_SIZE, Correction, _as_mask, _as_vector, _check_state, _is_float_matrix, check_covariance
+from ._ekf import (
+    _REASONS,
+    DEFAULT_PROCESS_NOISE,
+    STATE_SIZE,
+    Correction,
+    _as_mask,
+    _as_vector,
+    _check_state,
+    _is_float_matrix,
+    check_covariance,
+)
 
 __all__ = ["Ukf", "check_ukf_constants"]
 
@@ -160,7 +170,8 @@ class Ukf:
         variances made positive and at least 1e-9, angle innovations wrapped, Mahalanobis test)."""
         zv = _as_vector(z)
         Rm = R if _is_float_matrix(R) else check_covariance("R", R)
-        mk = mask if (type(mask) is np.ndarray and mask.dtype == np.bool_ and mask.shape == (STATE_SIZE,)) else _as_mask(mask)
+        exact = type(mask) is np.ndarray and mask.dtype == np.bool_ and mask.shape == (STATE_SIZE,)
+        mk = mask if exact else _as_mask(mask)
         threshold_sq = math.inf if mahalanobis_threshold == math.inf else float(mahalanobis_threshold) ** 2
         # the moved points serve only the state they were predicted to: not after a correction,
         # a reset, or a state written from outside (the first measurement, set_pose, a rewind)

@@ -120,11 +120,13 @@ def _walk(path: str, table: Pairs, keys: list[str], out: list[_Section]) -> None
     for key, value, line in table:
         if key == PARAMS_KEY:
             if not keys:
-                raise ParameterFileError(path, key, f"expected a node name (or /**) above ros__parameters (line {line})")
+                expected = f"expected a node name (or /**) above ros__parameters (line {line})"
+                raise ParameterFileError(path, key, expected)
             pattern = "/" + "/".join(t for k in keys for t in k.split("/") if t)
             where = f"{pattern}.{PARAMS_KEY}"
             if not isinstance(value, Pairs):
-                raise ParameterFileError(path, where, f"expected a mapping of parameters, found {_found(value)} (line {line})")
+                found = f"expected a mapping of parameters, found {_found(value)} (line {line})"
+                raise ParameterFileError(path, where, found)
             flat: dict[str, Any] = {}
             sources: dict[str, str] = {}
             _flatten(path, value, "", where, flat, sources)
@@ -157,7 +159,8 @@ def _flatten(path: str, table: Pairs, prefix: str, where: str, out: dict[str, An
             raise ParameterFileError(path, key_path, f"expected a value, found none (line {line})")
         if isinstance(value, list):
             if any(isinstance(v, (Pairs, list, NoValue)) for v in value):
-                raise ParameterFileError(path, key_path, f"expected a flat list of values, found {value!r} (line {line})")
+                found = f"expected a flat list of values, found {value!r} (line {line})"
+                raise ParameterFileError(path, key_path, found)
             try:
                 value = homogeneous(value, "the list")
             except ValueError as err:
