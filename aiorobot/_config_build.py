@@ -190,9 +190,9 @@ def _construct(config: GraphConfig, node_config: NodeConfig) -> Node:
     try:
         node = cls(**kwargs)
     except InvalidParameterValueError as err:
-        raise ConfigError(
-            config.path, _parameter_key(node_config, err.name), err.reason
-        ) from None
+        key = _parameter_key(node_config, err.name, config)
+        reason = err.reason if key.endswith(f".{err.name}") else f"parameter {err.name!r}: {err.reason}"
+        raise ConfigError(config.path, key, reason) from None
     except Exception as err:  # noqa: BLE001 - any constructor failure is a config problem
         raise ConfigError(
             config.path,
@@ -281,7 +281,14 @@ def _declared_parameters(node: Node) -> list[str]:
     return sorted(str(n) for n in names)
 
 
-def _parameter_key(node_config: NodeConfig, name: str) -> str:
+def _parameter_key(node_config: NodeConfig, name: str, config: GraphConfig | None = None) -> str:
+    """The key that gave ``name`` its value: the node's ``parameters`` table, else the parameter
+    file that did (the message then names that file's key)."""
+    if name not in node_config.parameters and config is not None:
+        if node_config.parameters_file is not None:
+            return f"{node_config.key}.parameters_file"
+        if config.runtime.parameters_file is not None:
+            return "runtime.parameters_file"
     return f"{node_config.key}.parameters.{name}"
 
 

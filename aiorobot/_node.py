@@ -100,7 +100,11 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._remappings = remaps
         self._fqn = join_fqn(self._namespace, self._name)
         self._parameters = ParameterStore(
-            self._fqn, arguments.overrides, allow_undeclared=allow_undeclared_parameters, quiet=arguments.quiet
+            self._fqn,
+            arguments.overrides,
+            allow_undeclared=allow_undeclared_parameters,
+            quiet=arguments.quiet,
+            sources=arguments.sources,
         )
         self._logger = NodeLogger(self._fqn)
         if arguments.log_level is not None:

@@ -184,6 +184,18 @@ class NodeParametersMixin:
     def remove_post_set_parameters_callback(self, callback: PostSetCallback) -> None:
         self._parameters.remove_post_set_callback(callback)
 
+    def get_parameter_overrides(self) -> dict[str, Any]:
+        """Every override given to the node as ``{name: value}``, whatever its source:
+        ``parameter_overrides`` (code, a TOML table), ``-p`` and ``--params-file`` (rclcpp's
+        ``get_parameter_overrides``). A node that reads its inputs from names it is given
+        (robot_localization's ``odom0``, ``imu0``...) reads them here."""
+        return dict(self._parameters.overrides)
+
+    def get_parameter_override_source(self, name: str) -> str | None:
+        """Where the override ``name`` was written (``"f.yaml: node.ros__parameters.x (line 3)"``,
+        ``"--ros-args -p x"``), or ``None`` for code and TOML tables; for error messages."""
+        return self._parameters.sources.get(name)
+
     def unclaimed_parameter_overrides(self) -> list[str]:
         """Overrides given to the node for parameters it never declared."""
         return self._parameters.unclaimed_overrides()

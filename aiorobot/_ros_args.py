@@ -4,13 +4,15 @@
 ROS arguments sit between ``--ros-args`` and ``--`` (or the end; there may be several
 such sections); the rest are the program's own arguments. Understood:
 
-- ``-p``/``--param [node:]name:=value`` (value read as YAML, as ``ros2 param set``),
+- ``-p``/``--param [node:]name:=value`` (value typed as rcl types YAML: ``1e-9`` is a double),
 - ``-r``/``--remap [node:]from:=to``, including ``__node:=name`` and ``__ns:=/ns``,
 - ``--params-file FILE``,
 - ``--log-level [logger:=]LEVEL``,
 - ``--enclave``/``-e VALUE``, ``--enable-rosout-logs`` and the like (accepted, no effect here).
 
-A ``node:`` prefix makes a rule apply only to the node of that name.
+A ``node:`` prefix makes a rule apply only to the node of that name. ``-p`` values and
+``--params-file`` sections apply in command-line order, as rcl reads them into one table
+(:func:`aiorobot._node_arguments.resolve_node_arguments`).
 """
 
 from __future__ import annotations
@@ -55,6 +57,8 @@ class RosArgs:
     params_files: list[str] = field(default_factory=list)
     log_levels: dict[str, str] = field(default_factory=dict)  # "" = the default level
     unparsed: list[str] = field(default_factory=list)
+    #: ``-p`` rules and ``--params-file`` paths in command-line order
+    overrides_in_order: list[Rule | str] = field(default_factory=list)
 
     def parameters_for(self, node_name: str) -> dict[str, Any]:
         """The ``-p`` values that apply to the node called ``node_name``; node-targeted ones win."""
@@ -75,7 +79,7 @@ class RosArgs:
 
 def parse_ros_args(argv: Sequence[str]) -> RosArgs:
     """Split ``argv`` into ROS arguments (parsed) and the program's own (``unparsed``)."""
-    from ._parameters import get_parameter_value, parameter_value_to_python
+    from .parameters._rcl_yaml import parse_yaml_value
 
     result = RosArgs()
     args = list(argv)
@@ -106,12 +110,18 @@ def parse_ros_args(argv: Sequence[str]) -> RosArgs:
         value = _value_of(args, i)
         if arg in ("-p", "--param"):
             node, name, text = _rule(arg, value, "name:=value")
-            result.parameters.append(Rule(node, name, parameter_value_to_python(get_parameter_value(text))))
+            try:
+                rule = Rule(node, name, parse_yaml_value(text))
+            except ValueError as err:
+                raise RosArgsError(f"{arg} {value}: {err}") from None
+            result.parameters.append(rule)
+            result.overrides_in_order.append(rule)
         elif arg in ("-r", "--remap"):
             node, source, target = _rule(arg, value, "from:=to")
             result.remappings.append(Rule(node, source, target))
         elif arg == "--params-file":
             result.params_files.append(value)
+            result.overrides_in_order.append(value)
         elif arg == "--log-level":
             logger, sep, level = value.rpartition(":=")
             if level.lower() not in LOG_LEVELS:

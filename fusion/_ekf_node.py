@@ -20,7 +20,7 @@ from ._inputs import (
     rotation_from_quaternion,
     twist_measurement,
 )
-from ._parameters import IGNORED_PARAMETERS, check_parameter_names, input_names
+from ._parameters import IGNORED_PARAMETERS, UKF_PARAMETERS, check_parameter_names, input_names
 from ._timeline import FilterTimeline, Measurement
 
 __all__ = ["EkfNode"]
@@ -58,22 +58,27 @@ class EkfNode(Node):
     robot_localization's own service types do not exist here.
     """
 
+    #: the other filter's own parameters: accepted with a warning that they have no effect here
+    _OTHER_FILTER_PARAMETERS: tuple[str, ...] = UKF_PARAMETERS
+    _OTHER_FILTER = "UkfNode's (robot_localization's ukf_node)"
+
     def __init__(self, name: str = "ekf_filter_node", **kw: Any) -> None:
         super().__init__(name, **kw)
-        given = self.unclaimed_parameter_overrides()
-        check_parameter_names(given)
+        # every override, whatever its source: code, a TOML table, -p or a parameter file
+        given = sorted(self.get_parameter_overrides())
+        check_parameter_names(given, filter_parameters=UKF_PARAMETERS, source=self.get_parameter_override_source)
         p = self._declare_globals()
+        log = self.get_logger()
         for ignored in sorted(set(given) & set(IGNORED_PARAMETERS)):
             self.declare_parameter(ignored, self._override_type_default(ignored))
-            self.get_logger().warning(f"robot_localization parameter {ignored!r} has no effect in aiorobot")
-        compile_kernels(self.get_logger(), Ekf.warm_up)  # here, not on the priority loop at the first message
-        self.ekf = Ekf(
-            process_noise=p["process_noise_covariance"],
-            initial_covariance=p["initial_estimate_covariance"],
-            initial_state=p["initial_state"],
-        )
+            log.warning(f"robot_localization parameter {ignored!r} has no effect in aiorobot")
+        for other in sorted(set(given) & set(self._OTHER_FILTER_PARAMETERS)):
+            self.declare_parameter(other, self._override_type_default(other))
+            log.warning(f"{other!r} is {self._OTHER_FILTER} parameter; it has no effect in {type(self).__name__}")
+        #: the filter core: an :class:`Ekf` here, a :class:`Ukf` in :class:`UkfNode`
+        self.filter = self._make_filter(p)
         self.timeline = FilterTimeline(
-            self.ekf,
+            self.filter,
             two_d_mode=p["two_d_mode"],
             smooth_lagged_data=p["smooth_lagged_data"],
             history_length_sec=p["history_length"],
@@ -105,6 +110,10 @@ class EkfNode(Node):
             self._tf = TransformBroadcaster(self)
         for input_name, kind in input_names(given):
             self._add_input(input_name, kind)
+        if self.inputs:
+            log.info(f"fusing {', '.join(f'{c.name} ({c.kind} on {c.topic})' for c in self.inputs)}")
+        else:
+            log.warning("no input given (odom0, imu0, pose0, twist0, ...): the filter has nothing to fuse")
         self._wire_services()
         self.create_timer(1.0 / self.frequency, self._on_period)
         if self.print_diagnostics:
@@ -114,9 +123,23 @@ class EkfNode(Node):
             self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
             self.create_timer(1.0, self.publish_diagnostics)
 
+    @property
+    def ekf(self) -> Any:
+        """The filter core (:attr:`filter`), under its older name."""
+        return self.filter
+
     # -- parameters ---------------------------------------------------------------------------
     def _override_type_default(self, name: str) -> Any:
         return None
+
+    def _make_filter(self, p: dict[str, Any]) -> Any:
+        """The filter core from the declared parameters, its kernels loaded (see :meth:`Ekf.warm_up`)."""
+        compile_kernels(self.get_logger(), Ekf.warm_up)  # here, not on the priority loop at the first message
+        return Ekf(
+            process_noise=p["process_noise_covariance"],
+            initial_covariance=p["initial_estimate_covariance"],
+            initial_state=p["initial_state"],
+        )
 
     def _declare_globals(self) -> dict[str, Any]:
         d = self.declare_parameter
@@ -359,7 +382,7 @@ class EkfNode(Node):
         """Publish ``odometry/filtered`` and the world -> base transform for the current state."""
         if not self.timeline.initialized:
             return
-        x, P = self.ekf.state, self.ekf.covariance
+        x, P = self.filter.state, self.filter.covariance
         if not math.isfinite(float(x.sum())):  # never publish NaN: start over from the initial estimate
             self._reject("filter", "state became non-finite; reset to the initial estimate")
             self.timeline.reset()

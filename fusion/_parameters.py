@@ -1,11 +1,19 @@
-"""robot_localization's ``ekf_node`` parameter names: the valid set and the nearest-name hint."""
+"""robot_localization's ``ekf_node`` and ``ukf_node`` parameter names: the valid set and the nearest-name hint."""
 
 from __future__ import annotations
 
 import difflib
 import re
+from collections.abc import Callable
 
-__all__ = ["GLOBAL_PARAMETERS", "IGNORED_PARAMETERS", "INPUT_SUFFIXES", "input_names", "check_parameter_names"]
+__all__ = [
+    "GLOBAL_PARAMETERS",
+    "IGNORED_PARAMETERS",
+    "INPUT_SUFFIXES",
+    "UKF_PARAMETERS",
+    "check_parameter_names",
+    "input_names",
+]
 
 #: the names aiorobot reads, with robot_localization's meaning (docs/fusion.md)
 GLOBAL_PARAMETERS = (
@@ -22,6 +30,8 @@ IGNORED_PARAMETERS = (
     "acceleration_gains", "deceleration_gains", "dynamic_process_noise_covariance",
     "use_dynamic_process_noise_covariance", "predict_to_current_time", "reset_on_time_jump",
 )  # fmt: skip
+#: ukf_node's own parameters (ukf_node.cpp): the unscented transform's spread and prior
+UKF_PARAMETERS = ("alpha", "kappa", "beta")
 INPUT_SUFFIXES = {
     "odom": ("", "_config", "_differential", "_relative", "_queue_size", "_pose_rejection_threshold",
              "_twist_rejection_threshold", "_pose_use_child_frame"),
@@ -45,10 +55,17 @@ def input_names(names: list[str]) -> list[tuple[str, str]]:
     return [(name, kind) for name, kind, _ in sorted(found, key=lambda f: (f[1], f[2]))]
 
 
-def check_parameter_names(names: list[str]) -> None:
-    """Raise ``ValueError`` naming the first unknown parameter and the nearest valid name."""
+def check_parameter_names(
+    names: list[str], *, filter_parameters: tuple[str, ...] = (), source: Callable[[str], str | None] | None = None
+) -> None:
+    """Raise ``ValueError`` naming the first parameter that belongs to neither filter, where it was
+    given (``source(name)``: a file and key, or ``-p``) and the nearest valid name.
+
+    Valid: the shared names, the ignored ones, the inputs' options, ``use_sim_time`` and
+    ``filter_parameters`` (both filters' own names: a node warns about the other filter's).
+    """
     inputs = input_names(names)
-    valid = set(GLOBAL_PARAMETERS) | set(IGNORED_PARAMETERS)
+    valid = set(GLOBAL_PARAMETERS) | set(IGNORED_PARAMETERS) | set(filter_parameters)
     for name, kind in inputs:
         valid.update(name + suffix for suffix in INPUT_SUFFIXES[kind])
     for name in sorted(names):
@@ -60,4 +77,6 @@ def check_parameter_names(names: list[str]) -> None:
             candidates += [m.group(1) + m.group(2) + s for s in INPUT_SUFFIXES[m.group(1)] if s]
         close = difflib.get_close_matches(name, candidates, n=1, cutoff=0.6)
         hint = f'; did you mean "{close[0]}"?' if close else ""
-        raise ValueError(f'unknown robot_localization parameter "{name}"{hint}')
+        where = source(name) if source is not None else None
+        origin = f" (from {where})" if where else ""
+        raise ValueError(f'unknown robot_localization parameter "{name}"{origin}{hint}')

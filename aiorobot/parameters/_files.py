@@ -25,6 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ._rcl_yaml import NoValue, Pairs, homogeneous, load_yaml
+
 __all__ = ["ParameterFile", "ParameterFileError", "load_parameter_file", "parameter_dict_from_yaml_file"]
 
 PARAMS_KEY = "ros__parameters"
@@ -40,28 +42,13 @@ class ParameterFileError(ValueError):
         super().__init__(f"{path}: {key}: {message}" if key else f"{path}: {message}")
 
 
-class _Pairs(list):  # type: ignore[type-arg]
-    """A YAML mapping kept as (key, value) pairs, repeated keys included."""
-
-
-def _loader() -> Any:
-    import yaml
-
-    class Loader(yaml.SafeLoader):
-        pass
-
-    def pairs(loader: Any, node: Any) -> _Pairs:
-        return _Pairs((loader.construct_object(k, deep=True), loader.construct_object(v, deep=True)) for k, v in node.value)
-
-    Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, pairs)
-    return Loader
-
-
 @dataclass(frozen=True, slots=True)
 class _Section:
     pattern: str  # as written, normalised: "/ns/*"
     regex: re.Pattern[str]
     parameters: Mapping[str, Any]
+    #: where each value was written: ``"params.yaml: node.ros__parameters.name (line 7)"``
+    sources: Mapping[str, str]
 
 
 def _node_regex(pattern: str) -> re.Pattern[str]:
@@ -94,59 +81,92 @@ class ParameterFile:
                 out.update(section.parameters)
         return out
 
+    def sources_for_node(self, fqn: str) -> dict[str, str]:
+        """``{name: "file: key (line N)"}`` for the values :meth:`for_node` gives."""
+        out: dict[str, str] = {}
+        for section in self.sections:
+            if section.regex.fullmatch(fqn):
+                out.update(section.sources)
+        return out
+
 
 def load_parameter_file(path: str | Path) -> ParameterFile:
-    """Read a ROS 2 parameter file; ``FileNotFoundError`` when missing, ``ParameterFileError`` when malformed."""
+    """Read a ROS 2 parameter file with rcl's scalar types (``1e-9`` is a double; see
+    :mod:`aiorobot.parameters._rcl_yaml`); ``FileNotFoundError`` when missing, ``ParameterFileError``
+    when malformed.
+
+    rclpy difference: a list mixing integers and doubles is a double array (rcl refuses it).
+    """
     import yaml
 
     text = Path(path).read_text(encoding="utf-8")
     name = str(path)
     try:
-        data = yaml.load(text, Loader=_loader())  # noqa: S506 - a SafeLoader subclass
+        data = load_yaml(text)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark is not None else ""
         raise ParameterFileError(name, None, f"not valid YAML{where}: {getattr(err, 'problem', err)}") from None
     if data is None:
         return ParameterFile(name, [])
-    if not isinstance(data, _Pairs):
+    if not isinstance(data, Pairs):
         raise ParameterFileError(name, None, f"expected a mapping of node names to sections, found {type(data).__name__}")
     sections: list[_Section] = []
     _walk(name, data, [], sections)
     return ParameterFile(name, sections)
 
 
-def _walk(path: str, table: _Pairs, keys: list[str], out: list[_Section]) -> None:
-    for key, value in table:
-        if not isinstance(key, str):
-            raise ParameterFileError(path, "/".join(keys + [str(key)]), f"expected a node name, found {key!r}")
+def _walk(path: str, table: Pairs, keys: list[str], out: list[_Section]) -> None:
+    for key, value, line in table:
         if key == PARAMS_KEY:
             if not keys:
-                raise ParameterFileError(path, key, "expected a node name (or /**) above ros__parameters")
+                expected = f"expected a node name (or /**) above ros__parameters (line {line})"
+                raise ParameterFileError(path, key, expected)
             pattern = "/" + "/".join(t for k in keys for t in k.split("/") if t)
-            if not isinstance(value, _Pairs):
-                raise ParameterFileError(path, f"{pattern}.{PARAMS_KEY}", f"expected a mapping of parameters, found {value!r}")
+            where = f"{pattern}.{PARAMS_KEY}"
+            if not isinstance(value, Pairs):
+                found = f"expected a mapping of parameters, found {_found(value)} (line {line})"
+                raise ParameterFileError(path, where, found)
             flat: dict[str, Any] = {}
-            _flatten(path, value, "", f"{pattern}.{PARAMS_KEY}", flat)
-            out.append(_Section(pattern, _node_regex(pattern), flat))
-        elif isinstance(value, _Pairs):
+            sources: dict[str, str] = {}
+            _flatten(path, value, "", where, flat, sources)
+            out.append(_Section(pattern, _node_regex(pattern), flat, sources))
+        elif isinstance(value, Pairs):
             _walk(path, value, keys + [key], out)
         else:
             where = "/".join(keys + [key])
-            raise ParameterFileError(path, where, f"expected a node section holding ros__parameters, found {value!r}")
+            raise ParameterFileError(
+                path, where, f"expected a node section holding ros__parameters, found {_found(value)} (line {line})"
+            )
 
 
-def _flatten(path: str, table: _Pairs, prefix: str, where: str, out: dict[str, Any]) -> None:
-    for key, value in table:
+def _found(value: Any) -> str:
+    if isinstance(value, NoValue):
+        return "no value"
+    if isinstance(value, Pairs):
+        return "a mapping"
+    return repr(value)
+
+
+def _flatten(path: str, table: Pairs, prefix: str, where: str, out: dict[str, Any], sources: dict[str, str]) -> None:
+    for key, value, line in table:
         name = f"{prefix}{key}"
-        if isinstance(value, _Pairs):
-            _flatten(path, value, f"{name}.", where, out)
-        elif isinstance(value, list) and any(isinstance(v, (_Pairs, list)) for v in value):
-            raise ParameterFileError(path, f"{where}.{name}", f"expected a flat list of values, found {value!r}")
-        elif value is None or isinstance(value, (bool, int, float, str, list)):
-            out[name] = value
-        else:
-            raise ParameterFileError(path, f"{where}.{name}", f"expected a bool, number, string or list, found {value!r}")
+        key_path = f"{where}.{name}"
+        if isinstance(value, Pairs):
+            _flatten(path, value, f"{name}.", where, out, sources)
+            continue
+        if isinstance(value, NoValue):
+            raise ParameterFileError(path, key_path, f"expected a value, found none (line {line})")
+        if isinstance(value, list):
+            if any(isinstance(v, (Pairs, list, NoValue)) for v in value):
+                found = f"expected a flat list of values, found {value!r} (line {line})"
+                raise ParameterFileError(path, key_path, found)
+            try:
+                value = homogeneous(value, "the list")
+            except ValueError as err:
+                raise ParameterFileError(path, key_path, f"{err} (line {line})") from None
+        out[name] = value
+        sources[name] = f"{path}: {key_path} (line {line})"
 
 
 def parameter_dict_from_yaml_file(

@@ -67,9 +67,12 @@ class ParameterStore:
         *,
         allow_undeclared: bool = False,
         quiet: set[str] | None = None,
+        sources: Mapping[str, str] | None = None,
     ) -> None:
         self.owner = owner
         self._quiet = set(quiet or ())  # from files and -p: may name parameters never declared
+        #: where a file or ``-p`` override was written, named in the error when it is refused
+        self.sources: dict[str, str] = dict(sources or {})
         self.overrides: dict[str, Any] = {k: _override_value(v) for k, v in (overrides or {}).items()}
         self.allow_undeclared = allow_undeclared
         self.event_hook: EventHook | None = None
@@ -120,6 +123,7 @@ class ParameterStore:
         if not isinstance(namespace, str):
             raise TypeError(f"namespace: expected a str, found {namespace!r}")
         prepared: list[tuple[str, Any, ParameterDescriptor]] = []
+        from_override: set[str] = set()
         for index, entry in enumerate(parameters):
             if not isinstance(entry, (tuple, list)) or not 1 <= len(entry) <= 3:
                 raise TypeError(
@@ -172,6 +176,7 @@ class ParameterStore:
             if not ignore_override and name in self.overrides:
                 self._claimed.add(name)
                 value = self.overrides[name]
+                from_override.add(name)
             if _is_value_msg(value):
                 raise ValueError(
                     f"parameter {name!r}: cannot declare from a ParameterValue message unless it is an override"
@@ -194,13 +199,19 @@ class ParameterStore:
                 try:
                     param = Parameter(name, ptype, coerce(ptype, value))
                 except TypeError as err:
-                    raise InvalidParameterTypeError(name, str(err)) from None
+                    raise InvalidParameterTypeError(name, self._from(name, str(err), from_override)) from None
             result = _drive(self._atomic([param], {name: d}, declaring=True), "declare_parameter")
             if not result.successful:
+                reason = self._from(name, result.reason, from_override)
                 if result.reason.startswith(_WRONG_TYPE):
-                    raise InvalidParameterTypeError(name, result.reason)
-                raise InvalidParameterValueError(name, result.reason)
+                    raise InvalidParameterTypeError(name, reason)
+                raise InvalidParameterValueError(name, reason)
         return [self._values[name] for name, _, _ in prepared]
+
+    def _from(self, name: str, reason: str, from_override: set[str]) -> str:
+        """``reason``, naming the file and key (or ``-p``) the refused override came from."""
+        source = self.sources.get(name) if name in from_override else None
+        return f"{reason} (from {source})" if source else reason
 
     def undeclare(self, name: str) -> None:
         if name not in self._values:

@@ -100,3 +100,22 @@ def test_wrongly_typed_file_value_names_the_parameter(tmp_path):
     )
     with pytest.raises(ConfigError, match="rate.*expected double, found string 'fast'"):
         build_nodes(load_config(path))
+
+
+def test_a_refused_file_value_names_the_yaml_file_and_key_not_a_toml_key(tmp_path):
+    path = _write(tmp_path, """\
+        [[nodes]]
+        use = "param_file_nodes:Ctl"
+        parameters_file = "ctl.yaml"
+        """, {"ctl.yaml": """\
+        ctl:
+          ros__parameters:
+            rate: 1e-3
+            gain: high
+        """})  # fmt: skip
+    with pytest.raises(ConfigError) as info:
+        build_nodes(load_config(path))
+    assert str(info.value) == (
+        f"{path}: nodes[0].parameters_file: parameter 'gain': expected double, found string 'high' "
+        f"(from {tmp_path / 'ctl.yaml'}: /ctl.ros__parameters.gain (line 4))"
+    )

@@ -135,7 +135,8 @@ def test_file_values_meet_declarations_and_nested_tables_flatten(tmp_path):
     node = Node("ctl", namespace="/robot", cli_args=["--ros-args", "--params-file", str(path), "-p", "pid.ki:=0.5"],
                 parameter_overrides={"names": ["z"]})
     assert node.declare_parameter("gain", 1.0).value == 2.0
-    assert node.declare_parameters("pid", [("kp", 0.0), ("ki", 0.0)])[1].value == 0.5  # -p beats the file
+    # as rcl: the -p value joins the file's earlier /** section, so /robot/ctl's own value, later, wins
+    assert node.declare_parameters("pid", [("kp", 0.0), ("ki", 0.0)])[1].value == 0.25
     assert node.declare_parameter("names", ["x"]).value == ["z"]  # parameter_overrides beat both
     assert node.unclaimed_parameter_overrides() == []  # file values for other nodes are not errors
 

@@ -105,7 +105,8 @@ def test_aiorobot_run_module_class_with_ros_args(tmp_path):
     done = _run(tmp_path, "my_nodes:Talker", "--duration", "0.1", "--ros-args", "-p", "rate:=5", "-r", "__node:=x",
                 "-r", "__ns:=/y", "-r", "chatter:=talk", "--params-file", "p.yaml")
     assert done.returncode == 0, done.stderr
-    assert "fqn=/y/x rate=5.0 gain=0.5 topic=/y/talk" in done.stdout
+    # -p rate:=5 comes before the file on the command line: the file's rate wins, as with rcl
+    assert "fqn=/y/x rate=2.0 gain=0.5 topic=/y/talk" in done.stdout
     assert "Traceback" not in done.stderr
 
 
