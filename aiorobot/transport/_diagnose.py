@@ -78,6 +78,11 @@ def _tls_verdict(raw: socket.socket, host: str, tls: Mapping[str, Any], timeout_
             except TimeoutError:
                 pass
     except ssl.SSLCertVerificationError as err:
+        if "mismatch" in (err.verify_message or ""):
+            return (
+                f"the router's certificate does not name {host} ({err.verify_message.rstrip('.')}): "
+                "add it to the certificate's subjectAltName, or connect with the name it has"
+            )
         return (
             f"the router's certificate is not trusted ({err.verify_message}); "
             f"root_ca_certificate {ca or '(system roots)'} must be the CA that signed it"
