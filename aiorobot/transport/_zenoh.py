@@ -496,9 +496,11 @@ class ZenohTransport(Transport):
         unlinked = _unlinked(self._session, plan.connect)
         if not unlinked:
             return
+        reasons = {endpoint: why_unreachable(endpoint, plan.tls) for endpoint in unlinked}
+        unlinked = _unlinked(self._session, tuple(unlinked))  # a link that came up while probing is no failure
         self._connect_failures += len(unlinked)
         for endpoint in unlinked:
-            why = why_unreachable(endpoint, plan.tls)
+            why = reasons[endpoint]
             if endpoint == DEFAULT_CONNECT and why.startswith(NOTHING_LISTENS):
                 if self._peers_chosen(plan) or _skip_router_check():
                     continue  # peer-to-peer by choice: the session does not need the router
