@@ -303,3 +303,36 @@ async def test_topic_pub_reports_how_many_subscribers_matched(router_port: int) 
             "aiorobot topic pub: warning: no subscriber matched /nobody within 2 s; "
             "publishing anyway ('aiorobot topic info' shows who is on it)"
         ]
+
+
+def test_the_plain_endpoint_check_reads_the_config_zenoh_will_use(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from aiorobot.transport._zenoh import build_session_config
+
+    for name in ("ZENOH_SESSION_CONFIG_URI", "ZENOH_CONFIG_OVERRIDE", "AIOROBOT_ZENOH_ALLOW_PLAIN"):
+        monkeypatch.delenv(name, raising=False)
+    acl_only = tmp_path / "acl.json5"  # access control alone secures a config too
+    acl_only.write_text('{ mode: "peer", listen: { endpoints: { peer: ["tcp/127.0.0.1:0"] } }, '
+                        'connect: { endpoints: [] }, access_control: { enabled: true } }')
+    with pytest.raises(ZenohConfigError, match=r"enables access control \(access_control/enabled\) but listens on plain tcp/127\.0\.0\.1:0: "):
+        build_session_config(config_file=str(acl_only))
+    monkeypatch.setenv("AIOROBOT_ZENOH_ALLOW_PLAIN", "tcp/127.0.0.1:1, tcp/127.0.0.1:0")
+    _, plan = build_session_config(config_file=str(acl_only))
+    assert (plan.mode, plan.listen, plan.connect) == ("peer", ("tcp/127.0.0.1:0",), ())
+    # the default session is not secured: no check; an override that secures it is checked
+    _, plan = build_session_config()
+    assert plan.secure is None
+    monkeypatch.delenv("AIOROBOT_ZENOH_ALLOW_PLAIN")
+    monkeypatch.setenv("ZENOH_CONFIG_OVERRIDE", "access_control/enabled=true")
+    with pytest.raises(ZenohConfigError, match=r"^the default session config: listen/endpoints: .* plain tcp/127\.0\.0\.1:0: "):
+        build_session_config()
+    monkeypatch.setenv("ZENOH_CONFIG_OVERRIDE", "mode")
+    with pytest.raises(ZenohConfigError, match=r"^ZENOH_CONFIG_OVERRIDE: expected key=value, found 'mode'$"):
+        build_session_config()
+    monkeypatch.delenv("ZENOH_CONFIG_OVERRIDE")
+    monkeypatch.setenv("ZENOH_SESSION_CONFIG_URI", str(tmp_path / "gone.json5"))
+    with pytest.raises(ZenohConfigError) as caught:
+        build_session_config()
+    assert str(caught.value) == (
+        f"{tmp_path / 'gone.json5'}: expected a zenoh config file (JSON5) (named by ZENOH_SESSION_CONFIG_URI), "
+        f"found no file at {tmp_path / 'gone.json5'}"
+    )
