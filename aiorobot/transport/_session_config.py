@@ -242,21 +242,22 @@ def _check_tls_files(plan: SessionPlan) -> None:
             raise ZenohConfigError(plan.source, where, f"cannot read {path.resolve()}: {err.strerror}") from None
         if b"-----BEGIN " not in head:
             raise ZenohConfigError(plan.source, where, f"expected a PEM file (-----BEGIN ...), found {path.resolve()} without one")
+    def given(key: str) -> bool:
+        return bool(tls.get(key) or tls.get(key + "_base64"))
+
     for side in ("listen", "connect"):
-        cert, key = tls.get(f"{side}_certificate") or tls.get(f"{side}_certificate_base64"), tls.get(
-            f"{side}_private_key"
-        ) or tls.get(f"{side}_private_key_base64")
-        if bool(cert) != bool(key):
-            missing = f"{side}_private_key" if cert else f"{side}_certificate"
-            raise ZenohConfigError(plan.source, f"{_TLS}/{missing}", f"expected it beside {_TLS}/{side}_{'certificate' if cert else 'private_key'}, found it unset")
+        cert, key = f"{side}_certificate", f"{side}_private_key"
+        if given(cert) != given(key):
+            missing, present = (key, cert) if given(cert) else (cert, key)
+            raise ZenohConfigError(plan.source, f"{_TLS}/{missing}", f"expected it beside {_TLS}/{present}, found it unset")
     tls_listen = [ep for ep in plan.listen if scheme(ep) in SECURE_SCHEMES]
-    if tls_listen and not (tls.get("listen_certificate") or tls.get("listen_certificate_base64")):
+    if tls_listen and not given("listen_certificate"):
         raise ZenohConfigError(
             plan.source, f"{_TLS}/listen_certificate",
             f"listening on {tls_listen[0]} needs a certificate and key (listen_certificate, listen_private_key), found none",
         )
     tls_connect = [ep for ep in plan.connect if scheme(ep) in SECURE_SCHEMES]
-    if tls_connect and tls.get("enable_mtls") and not (tls.get("connect_certificate") or tls.get("connect_certificate_base64")):
+    if tls_connect and tls.get("enable_mtls") and not given("connect_certificate"):
         raise ZenohConfigError(
             plan.source, f"{_TLS}/connect_certificate",
             f"enable_mtls is true and the session connects to {tls_connect[0]}, but it has no client certificate "
