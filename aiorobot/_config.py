@@ -383,6 +383,12 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
         if transport != "zenoh":
             raise checker.error("runtime.zenoh_config", 'only applies with transport = "zenoh"')
         zenoh_config = str(resolved)
+        from .transport._session_config import check_session_file
+
+        try:  # parses, its certificates are there, no plain endpoint past TLS: before anything starts
+            check_session_file(zenoh_config)
+        except ConfigError as err:
+            raise checker.error("runtime.zenoh_config", str(err)) from None
     seconds = {}
     for name, default in (("shutdown_timeout", 2.0), ("stall_threshold", 0.5), ("priority_stall_threshold", 0.05)):
         value = table.get(name, default)

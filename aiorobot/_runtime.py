@@ -205,7 +205,14 @@ class Runtime:
         self._waker = make_waker(self._loop, precise=True)
         self._shutdown_event = asyncio.Event()
         self._watchdog.watch("main", self._loop, self._thread_id, self._stall_thresholds["main"])
-        await self.transport.open(self._bus)
+        try:
+            await self.transport.open(self._bus)
+        except BaseException:  # a refused session or a bad config: leave nothing started behind
+            self._watchdog.unwatch(self._loop)
+            self._watchdog.close()
+            self._waker.close()
+            self._waker = None
+            raise
         if self.use_sim_time:
             from .msgs.rosgraph_msgs import Clock as ClockMsg
 

@@ -55,6 +55,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         _silence_stdout()
         return 141
+    except Exception as err:
+        status = _one_line_error(err)
+        if status is None:
+            raise
+        return status
+
+
+def _one_line_error(err: Exception) -> int | None:
+    """A configuration error (exit 2) or a refused zenoh session (exit 1) that reached the top
+    from any command, printed as its one line; None for anything else (a bug: the traceback stays).
+    The classes are looked up only if their modules were imported, so raising them imported them."""
+    config = sys.modules.get("aiorobot._config")
+    if config is not None and isinstance(err, config.ConfigError):
+        print(err, file=sys.stderr)
+        return 2
+    session = sys.modules.get("aiorobot.transport._session_config")
+    if session is not None and isinstance(err, session.ZenohSessionError):
+        print(f"aiorobot: error: {err}", file=sys.stderr)
+        return 1
+    return None
 
 
 def _silence_stdout() -> None:

@@ -95,6 +95,15 @@ async def _pub(rt: Any, args: argparse.Namespace, msg_type: Any, msg: Any) -> in
     deadline = time.monotonic() + 2.0
     while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
         await asyncio.sleep(0.02)  # give subscribers a moment to match, as ros2 topic pub does
+    matched = pub.get_subscription_count()
+    if matched:
+        print(f"matched {matched} subscriber{'s' if matched != 1 else ''} on {pub.topic_name}", flush=True)
+    else:  # never publish into the void silently (no router, a typo in the topic, nobody listening yet)
+        print(
+            f"aiorobot topic pub: warning: no subscriber matched {pub.topic_name} within 2 s; "
+            "publishing anyway ('aiorobot topic info' shows who is on it)",
+            file=sys.stderr, flush=True,
+        )
     n = 0
     while times is None or n < times:
         pub.publish(msg)

@@ -38,6 +38,17 @@ from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolic
 from .._services import Client, Service, _Call, _reply
 from .._errors import ServiceError
 from .._transport import Transport
+from ._diagnose import NOTHING_LISTENS, host_port, why_unreachable
+from ._session_config import (
+    SessionPlan,
+    ZenohSessionError,
+    allowed_plain,
+    apply_overrides,
+    check_plan,
+    load_config_file,
+    plan_of,
+    zenoh_error_text,
+)
 from ._wire import (
     WireError,
     data_key,
@@ -55,7 +66,7 @@ if TYPE_CHECKING:
     from .._graph import NodeInfo
     from .._node import Node
 
-__all__ = ["TransportStatistics", "ZenohTransport"]
+__all__ = ["TransportStatistics", "ZenohTransport", "build_session_config"]
 
 _log = logging.getLogger("aiorobot.transport")
 
@@ -69,6 +80,10 @@ WARN_INTERVAL_SEC = 1.0
 SHM_ALLOC_SIZE = 48 * 1024 * 1024
 SHM_THRESHOLD = 2 * 1024
 SHM_MIN_CHECK = 1024  # smaller payloads are never in shared memory here: skip asking
+#: ``SessionPlan.source`` of a session made without a config file
+DEFAULT_SOURCE = "the default session config"
+#: the "no zenoh router" warning is given once a process
+_router_warned = threading.Event()
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
 
@@ -99,6 +114,9 @@ class TransportStatistics:
     sent_shm: int = 0
     #: of ``received``, the messages that arrived in shared memory (from a peer on this host)
     received_shm: int = 0
+    #: connect endpoints the session could not link to when it opened (each one warned about,
+    #: except the default router of a session that has peer endpoints of its own)
+    connect_failures: int = 0
 
 
 class _Owner:
@@ -374,6 +392,11 @@ class ZenohTransport(Transport):
         ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``) applies last, as in rmw_zenoh.
     connect, listen
         Endpoints replacing the defaults.
+    allow_plain
+        Plain (non-TLS) endpoints allowed in a config that enables TLS or access control
+        (``AIOROBOT_ZENOH_ALLOW_PLAIN`` adds more); any other plain listener or connect
+        endpoint there, zenoh's peer default ``tcp/[::]:0`` included, refuses to open
+        (:class:`~aiorobot.transport.ZenohConfigError`). See docs/security.md.
     shared_memory
         ``True``/``False`` sets zenoh's ``transport/shared_memory/enabled`` (over a config
         file too); ``None``: on with the default config, as the file says with one. When on,
@@ -392,8 +415,11 @@ class ZenohTransport(Transport):
         connect: list[str] | None = None,
         listen: list[str] | None = None,
         shared_memory: bool | None = None,
+        allow_plain: list[str] | tuple[str, ...] = (),
     ) -> None:
         super().__init__(domain_id=domain_id)
+        self.allow_plain = tuple(allow_plain)
+        self._connect_failures = 0
         self.config_file = config_file
         self.connect = connect
         self.listen = listen
@@ -433,56 +459,62 @@ class ZenohTransport(Transport):
 
     # -- session --------------------------------------------------------------------
 
-    def _config(self) -> Any:
-        import zenoh
-
-        path = self.config_file or os.environ.get("ZENOH_SESSION_CONFIG_URI")
-        if path:
-            try:
-                cfg = zenoh.Config.from_file(path)
-            except Exception as err:
-                raise ValueError(f"zenoh_config: cannot load {path!r}: {err}") from None
-        else:
-            cfg = zenoh.Config()
-            cfg.insert_json5("mode", '"peer"')
-            cfg.insert_json5("scouting/multicast/enabled", "false")
-            cfg.insert_json5("listen/endpoints", json.dumps(self.listen or [DEFAULT_LISTEN]))
-            cfg.insert_json5("connect/endpoints", json.dumps(self.connect if self.connect is not None else [DEFAULT_CONNECT]))
-            # zenoh's lazy batching holds a small message up to batching/time_limit (1 ms) and, at a
-            # steady 1-2 kHz, for several: 3-5 ms one-way on loopback instead of ~0.2 ms. A robot's
-            # graph wants latency; a config file (or ZENOH_CONFIG_OVERRIDE) can turn it back on.
-            cfg.insert_json5("transport/link/tx/queue/batching/enabled", "false")
-            # Large messages (images, clouds) to peers on this host go through shared memory;
-            # zenoh falls back to the network for a peer that cannot map it.
-            cfg.insert_json5("transport/shared_memory/enabled", "true")
-        cfg.insert_json5("timestamping/enabled", "true")  # the advanced publisher's cache needs it
-        if self.shared_memory is not None:
-            cfg.insert_json5("transport/shared_memory/enabled", json.dumps(bool(self.shared_memory)))
-        override = os.environ.get("ZENOH_CONFIG_OVERRIDE", "")
-        for item in filter(None, (part.strip() for part in override.split(";"))):
-            key, sep, value = item.partition("=")
-            if not sep:
-                raise ValueError(f"ZENOH_CONFIG_OVERRIDE: expected key=value, found {item!r}")
-            try:
-                cfg.insert_json5(key.strip(), value.strip())
-            except Exception as err:
-                raise ValueError(f"ZENOH_CONFIG_OVERRIDE: cannot set {key.strip()!r} to {value.strip()!r}: {err}") from None
-        return cfg
+    def _config(self) -> tuple[Any, SessionPlan]:
+        return build_session_config(
+            config_file=self.config_file, connect=self.connect, listen=self.listen,
+            shared_memory=self.shared_memory, allow_plain=self.allow_plain,
+        )
 
     async def open(self, bus: Bus) -> None:
         import zenoh
 
+        cfg, plan = self._config()  # a bad config or certificate path: ZenohConfigError, nothing opened
         await super().open(bus)
         self._loop = asyncio.get_running_loop()
         self._owner = _Owner(self._loop, threading.get_ident(), "<zenoh>")
-        cfg = self._config()
-        self._session = await asyncio.to_thread(zenoh.open, cfg)
+        try:
+            self._session = await asyncio.to_thread(zenoh.open, cfg)
+        except Exception as err:  # noqa: BLE001 - zenoh raises ZError: say what was refused, and where
+            raise ZenohSessionError(await asyncio.to_thread(_refusal, plan, err)) from None
         self._zid = str(self._session.zid())
         self._open_shm(cfg)
         bus.services.listener = self  # type: ignore[attr-defined]
         self._liveliness_sub = self._session.liveliness().declare_subscriber(
             f"@ros2_lv/{self.domain_id}/**", self._on_token, history=True
         )
+        await asyncio.to_thread(self._report_unlinked, plan)
+
+    def _peers_chosen(self, plan: SessionPlan) -> bool:
+        """The caller or the file chose endpoints beyond the default router: peer-to-peer links."""
+        if plan.source == DEFAULT_SOURCE:
+            return self.listen is not None or (self.connect is not None and list(self.connect) != [DEFAULT_CONNECT])
+        return not plan.listen_is_default or list(plan.connect) != [DEFAULT_CONNECT]
+
+    def _report_unlinked(self, plan: SessionPlan) -> None:
+        """A peer whose connect endpoints did not link opens anyway and would run on alone, silently:
+        say which and why (one warning each, counted in ``statistics().connect_failures``)."""
+        unlinked = _unlinked(self._session, plan.connect)
+        if not unlinked:
+            return
+        reasons = {endpoint: why_unreachable(endpoint, plan.tls) for endpoint in unlinked}
+        unlinked = _unlinked(self._session, tuple(unlinked))  # a link that came up while probing is no failure
+        self._connect_failures += len(unlinked)
+        for endpoint in unlinked:
+            why = reasons[endpoint]
+            if endpoint == DEFAULT_CONNECT and why.startswith(NOTHING_LISTENS):
+                if self._peers_chosen(plan) or _skip_router_check():
+                    continue  # peer-to-peer by choice: the session does not need the router
+                if not _router_warned.is_set():  # once a process, as rmw_zenoh's router check
+                    _router_warned.set()
+                    _log.warning(
+                        f"no zenoh router at {DEFAULT_CONNECT}; other processes will not be found: "
+                        "start `aiorobot router`"
+                    )
+                continue
+            _log.warning(
+                f"zenoh session ({plan.mode} mode, {plan.source}) could not connect to {endpoint}: {why}; "
+                "it runs without it and keeps retrying"
+            )
 
     async def close(self) -> None:
         session = self._session
@@ -524,7 +556,7 @@ class ZenohTransport(Transport):
     def statistics(self) -> TransportStatistics:
         return TransportStatistics(
             self._sent, self._received, sum(self._drops.values()), dict(self._drops), len(self._remote_nodes),
-            self._sent_shm, self._received_shm,
+            self._sent_shm, self._received_shm, self._connect_failures,
         )
 
     def remote_nodes(self) -> tuple[NodeInfo, ...]:
@@ -925,6 +957,91 @@ class ZenohTransport(Transport):
         else:
             entry.destroyed = True
             bus.services.remove(entry)
+
+
+def build_session_config(
+    *,
+    config_file: str | None = None,
+    connect: list[str] | None = None,
+    listen: list[str] | None = None,
+    shared_memory: bool | None = None,
+    allow_plain: tuple[str, ...] | list[str] = (),
+) -> tuple[Any, SessionPlan]:
+    """The ``zenoh.Config`` a :class:`ZenohTransport` opens, and what it will do, checked.
+
+    Raises :class:`ZenohConfigError` (one line: file, key, problem) for a file that does not
+    parse, a certificate or key that is not there, or a plain endpoint in a secured config.
+    """
+    import zenoh
+
+    path = config_file
+    named_by = None
+    if not path and os.environ.get("ZENOH_SESSION_CONFIG_URI", "").strip():
+        path, named_by = os.environ["ZENOH_SESSION_CONFIG_URI"].strip(), "ZENOH_SESSION_CONFIG_URI"
+    if path:
+        cfg = load_config_file(path, named_by=named_by)
+    else:
+        cfg = zenoh.Config()
+        cfg.insert_json5("mode", '"peer"')
+        cfg.insert_json5("scouting/multicast/enabled", "false")
+        cfg.insert_json5("listen/endpoints", json.dumps(listen or [DEFAULT_LISTEN]))
+        cfg.insert_json5("connect/endpoints", json.dumps(connect if connect is not None else [DEFAULT_CONNECT]))
+        # zenoh's lazy batching holds a small message up to batching/time_limit (1 ms) and, at a
+        # steady 1-2 kHz, for several: 3-5 ms one-way on loopback instead of ~0.2 ms. A robot's
+        # graph wants latency; a config file (or ZENOH_CONFIG_OVERRIDE) can turn it back on.
+        cfg.insert_json5("transport/link/tx/queue/batching/enabled", "false")
+        # Large messages (images, clouds) to peers on this host go through shared memory;
+        # zenoh falls back to the network for a peer that cannot map it.
+        cfg.insert_json5("transport/shared_memory/enabled", "true")
+    cfg.insert_json5("timestamping/enabled", "true")  # the advanced publisher's cache needs it
+    if shared_memory is not None:
+        cfg.insert_json5("transport/shared_memory/enabled", json.dumps(bool(shared_memory)))
+    apply_overrides(cfg, os.environ.get("ZENOH_CONFIG_OVERRIDE", ""))
+    plan = plan_of(cfg, path or DEFAULT_SOURCE)
+    check_plan(plan, allowed_plain(allow_plain))
+    return cfg, plan
+
+
+def _skip_router_check() -> bool:
+    """``ZENOH_ROUTER_CHECK_ATTEMPTS`` < 0 skips rmw_zenoh's router check; it skips the warning here."""
+    raw = os.environ.get("ZENOH_ROUTER_CHECK_ATTEMPTS", "").strip()
+    try:
+        return int(raw) < 0
+    except ValueError:
+        return False
+
+
+def _unlinked(session: Any, endpoints: tuple[str, ...]) -> list[str]:
+    """Of ``endpoints``, those the session holds no link to (zenoh tried each once in ``open``)."""
+    import socket
+
+    linked: set[tuple[str, str, int]] = set()
+    for link in session.info.links():
+        proto, target = str(link.dst).split("/", 1)[0].lower(), host_port(str(link.dst))
+        if target is not None:
+            linked.add((proto, target[0], target[1]))
+    missing = []
+    for endpoint in endpoints:
+        target = host_port(endpoint)
+        if target is None:
+            continue  # not an IP endpoint (unix socket, serial): zenoh's own word stands
+        proto = endpoint.split("/", 1)[0].lower()
+        try:
+            addresses = {info[4][0] for info in socket.getaddrinfo(target[0], target[1], proto=socket.IPPROTO_TCP)}
+        except OSError:
+            addresses = {target[0]}
+        if not any((proto, a, target[1]) in linked for a in addresses):
+            missing.append(endpoint)
+    return missing
+
+
+def _refusal(plan: SessionPlan, err: BaseException) -> str:
+    """The one line for a session zenoh would not open (client mode reaching no router, ...)."""
+    text = zenoh_error_text(err)
+    if "Unable to connect" not in text or not plan.connect:
+        return f"zenoh could not open the session ({plan.mode} mode, {plan.source}): {text}"
+    reasons = "; ".join(f"{ep}: {why_unreachable(ep, plan.tls)}" for ep in plan.connect)
+    return f"zenoh session refused ({plan.mode} mode, {plan.source}): {reasons}"
 
 
 def _ignore(_msg: Any) -> None:
