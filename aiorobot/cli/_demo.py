@@ -1,4 +1,10 @@
-"""``aiorobot demo``: the simulated mecanum robot navigating a waypoint mission, with a summary."""
+"""``aiorobot demo``: the simulated mecanum robot navigating a waypoint mission, with a summary.
+
+``--world`` is a built-in name (``warehouse``, ``box``: each has a shipped mission) or a map
+YAML path (a Nav2 map, say: a path is always a path, whatever its name, and needs
+``--waypoints``). Exit status: 0 when every waypoint was reached without collision; 1
+otherwise; 2 for bad arguments or a bad world; 130 on Ctrl-C.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +13,9 @@ import json
 import math
 import sys
 from pathlib import Path
+
+from ._parser import accept_negative_number_lists
+from ._sim import start_pose
 
 __all__ = ["add_arguments", "main", "run_as_default"]
 
@@ -27,15 +36,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "localisation on the map, costmap + A* + Regulated Pure Pursuit navigation with recoveries. Prints progress "
         "and a summary against ground truth; exit status 0 only when every waypoint was reached without collision."
     )
-    parser.add_argument("--world", default="warehouse", metavar="NAME|PATH", help="built-in world (warehouse, box) or a map YAML")
-    parser.add_argument("--waypoints", metavar="'x,y[,yaw];...'", help="a mission of your own (default: the world's shipped one)")
+    parser.add_argument("--world", default="warehouse", metavar="NAME|PATH",
+                        help="built-in world (warehouse, box) or a map YAML path, such as a Nav2 map (needs --waypoints)")
+    parser.add_argument("--waypoints", metavar="'x,y[,yaw];...'",
+                        help="a mission of your own (default: a built-in world's shipped one)")
+    parser.add_argument("--start", type=start_pose, metavar="X,Y[,YAW]",
+                        help="start pose in map (m, m, rad); default: the world's start, or on a map whose start is "
+                        "blocked (a Nav2 map's origin) the free cell nearest to it, with a warning")
     parser.add_argument("--rtf", type=_rtf, default=0.0, help="real-time factor (default 0: as fast as the machine allows)")
     parser.add_argument("--time-source", choices=("sim", "system"), default=None,
                         help="system: the simulator stamps with system time and every node runs on the system clock, "
                         "as on a robot (needs --rtf 1); sim: every node follows the simulator's /clock "
                         "(default: system at --rtf 1, else sim)")
     parser.add_argument("--seed", type=int, default=1, help="seed of every noise model (default 1)")
-    parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC", help="give up after this much sim time (default 600)")
+    parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC",
+                        help="give up after this much sim time (default 600)")
     parser.add_argument("--drive", choices=("serial", "direct"), default=None,
                         help="serial: the mecanum base through the simulated ESP32 firmware on a pty (SerialMotorBridge + "
                         "MecanumController), which runs on the wall clock and so needs --rtf > 0; direct: the simulator "
@@ -52,6 +67,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="record the run's topics (raw camera frames excluded) into a rosbag2 directory with MCAP storage")
     parser.add_argument("--json", type=Path, metavar="FILE", help="write the summary's figures as JSON")
     parser.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the map with true, estimated and planned paths")
+    accept_negative_number_lists(parser)
 
 
 def run_as_default(duration_sec: float | None = None) -> int:
@@ -63,17 +79,20 @@ def run_as_default(duration_sec: float | None = None) -> int:
 
 def main(args: argparse.Namespace) -> int:
     import aiorobot
-    from aiorobot.demo import MISSIONS, parse_waypoints, run_demo
-    from aiorobot.sim import World, WorldError
+    from aiorobot.demo import DemoSetupError, mission_for, parse_waypoints, run_demo
+    from aiorobot.demo._graph import ROBOT_RADIUS
+    from aiorobot.demo._mission import no_mission_message
+    from aiorobot.sim import World, WorldError, resolve_start
 
     try:
         world = World.load(args.world)
-        waypoints = parse_waypoints(args.waypoints) if args.waypoints else MISSIONS.get(world.name)
+        waypoints = parse_waypoints(args.waypoints) if args.waypoints else mission_for(args.world)
         if waypoints is None:
-            raise ValueError(f"world {args.world!r} has no shipped mission; give one with --waypoints 'x,y[,yaw];...'")
+            raise ValueError(no_mission_message(args.world))
         for i, (x, y, _) in enumerate(waypoints):
-            if not world.is_free_disc(x, y, 0.22):
-                raise ValueError(f"waypoint {i + 1} ({x:g}, {y:g}) is outside the map or inside an obstacle of {world.name}")
+            if not world.is_free_disc(x, y, ROBOT_RADIUS):
+                raise ValueError(f"waypoint {i + 1} ({x:g}, {y:g}) is outside the map or inside an obstacle of {args.world}")
+        start = resolve_start(world, args.start, ROBOT_RADIUS)
         drive = args.drive or ("serial" if args.rtf > 0 else "direct")
         if drive == "serial" and args.rtf == 0:
             raise ValueError("--drive serial needs --rtf > 0 (the simulated firmware's pty runs on the wall clock); "
@@ -98,7 +117,9 @@ def main(args: argparse.Namespace) -> int:
         sys.stderr.flush()
 
     time_source = args.time_source or ("system" if args.rtf == 1 else "sim")
-    print(f"aiorobot demo: {world.name}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
+    if start.warning is not None:
+        print(f"aiorobot demo: warning: {start.warning}", file=sys.stderr)
+    print(f"aiorobot demo: {args.world}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
           f"{args.localisation} localisation, seed {args.seed}, "
           f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time "
           "(Ctrl-C stops)", file=sys.stderr)
@@ -107,7 +128,11 @@ def main(args: argparse.Namespace) -> int:
                                         localisation=args.localisation, perception=args.perception,
                                         record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress,
-                                        time_source=args.time_source, realtime=args.realtime))
+                                        time_source=args.time_source, realtime=args.realtime,
+                                        start=start.pose))
+    except DemoSetupError as err:  # a node refused what the checks above let through (nothing started)
+        print(f"aiorobot demo: error: {err}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("\naiorobot demo: interrupted", file=sys.stderr)
         return 130

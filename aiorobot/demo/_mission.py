@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import gc
+import logging
 import math
 import threading
 import time
@@ -13,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MISSIONS", "DemoSummary", "parse_waypoints", "run_demo"]
+__all__ = ["MISSIONS", "DemoSetupError", "DemoSummary", "mission_for", "parse_waypoints", "run_demo"]
 
 _PI = math.pi
 #: The shipped missions: (x, y, yaw) waypoints per built-in world.
@@ -29,6 +30,21 @@ MISSIONS: dict[str, list[tuple[float, float, float]]] = {
     ],
     "box": [(2.0, 0.0, _PI / 2), (2.0, 2.0, _PI), (-2.0, 2.0, -_PI / 2), (-2.0, -2.0, 0.0), (0.0, 0.0, 0.0)],
 }
+
+
+class DemoSetupError(ValueError):
+    """The demo cannot start with what it was given (world, start, waypoints, options); nothing was started."""
+
+
+def mission_for(world: str) -> list[tuple[float, float, float]] | None:
+    """The shipped mission of a built-in world named by its bare name; None for anything else.
+
+    A path is a path: a map file that happens to be called ``warehouse.yaml`` (Nav2 ships one)
+    is not the built-in warehouse and has no mission.
+    """
+    from aiorobot.sim import BUILTIN_WORLDS
+
+    return list(MISSIONS[world]) if world in BUILTIN_WORLDS and world in MISSIONS else None
 
 
 def parse_waypoints(text: str) -> list[tuple[float, float, float]]:
@@ -52,6 +68,7 @@ def parse_waypoints(text: str) -> list[tuple[float, float, float]]:
 class DemoSummary:
     """The demo's figures (``--json`` writes these keys)."""
 
+    #: the built-in world's name or the map YAML's path, as given
     world: str
     waypoints_reached: int = 0
     waypoints_total: int = 0
@@ -92,6 +109,8 @@ class DemoSummary:
     workers_cpu_pct: float = 0.0
     record: str | None = None
     status: str = "UNKNOWN"
+    #: where the robot started (x, y, yaw in map)
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
     missed: list[int] = field(default_factory=list)
     truth: list[tuple[float, float]] = field(default_factory=list, repr=False)
     estimate: list[tuple[float, float]] = field(default_factory=list, repr=False)
@@ -99,6 +118,7 @@ class DemoSummary:
 
     @property
     def succeeded(self) -> bool:
+        """Every waypoint reached without collision."""
         return self.waypoints_total > 0 and self.waypoints_reached == self.waypoints_total and self.collisions == 0
 
     def figures(self) -> dict[str, Any]:
@@ -271,6 +291,7 @@ async def run_demo(
     record: str | None = None,
     time_source: str | None = None,
     realtime: bool = False,
+    start: tuple[float, float, float] | None = None,
 ) -> DemoSummary:
     """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows.
 
@@ -285,24 +306,36 @@ async def run_demo(
     ``record`` is a directory for a rosbag2/MCAP bag of the run's topics (raw images excluded).
     ``realtime`` runs the priority loop's thread SCHED_FIFO where the OS permits it (as ros2_control's
     controller manager does); otherwise a warning, and the run goes on.
+
+    ``world`` is a built-in name or a map YAML path; only a built-in name has a shipped mission
+    (:func:`mission_for`), so a path needs ``waypoints``. ``start`` (x, y, yaw) is where the robot
+    starts; None takes the world's start, or the free cell nearest it with a logged warning (a
+    Nav2 map's origin is often blocked).
     """
     from aiorobot import Node, Runtime
     from aiorobot.nav import Navigator, TaskResult, pose_stamped
-    from aiorobot.sim import World
+    from aiorobot.sim import World, resolve_start
 
-    from ._graph import build_graph
+    from ._graph import ROBOT_RADIUS, build_graph
 
-    loaded = World.load(world)
-    if waypoints is None:
-        if loaded.name not in MISSIONS:
-            raise ValueError(f"world {world!r} has no shipped mission; give one with --waypoints 'x,y[,yaw];...'")
-        waypoints = MISSIONS[loaded.name]
+    world = str(world)
     if drive is None:
         drive = "serial" if rtf > 0 else "direct"
-    graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
-                        record=record, time_source=time_source)
-    summary = DemoSummary(world=loaded.name, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
-                          localisation=localisation, time_source=graph.time_source)
+    try:  # everything that can refuse the input, before anything starts
+        loaded = World.load(world)
+        if waypoints is None:
+            waypoints = mission_for(world)
+            if waypoints is None:
+                raise ValueError(no_mission_message(world))
+        choice = resolve_start(loaded, start, ROBOT_RADIUS)
+        graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
+                            record=record, time_source=time_source, start=choice.pose)
+    except ValueError as err:  # WorldError and the nodes' parameter errors among them
+        raise DemoSetupError(str(err)) from err
+    if choice.warning is not None:
+        logging.getLogger("aiorobot.demo").warning(choice.warning)
+    summary = DemoSummary(world=world, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
+                          localisation=localisation, time_source=graph.time_source, start=choice.pose)
     # What exists now (imported modules, Numba's and the simulator's start-up objects: most of the heap) is
     # left out of the cyclic collector's full passes: such a pass stops every thread, the priority loop's
     # included, for as long as it walks the heap (66 ms seen in the warehouse at --rtf 1; ~1 ms after this).
@@ -384,6 +417,14 @@ async def run_demo(
     if graph.recorder is not None:
         summary.record = graph.recorder.path
     return summary
+
+
+def no_mission_message(world: str) -> str:
+    """The one line for a world without a shipped mission and no waypoints given."""
+    from aiorobot.sim import BUILTIN_WORLDS
+
+    return (f"world {world!r} has no shipped mission (only the built-in worlds {', '.join(BUILTIN_WORLDS)}, named "
+            "without a path, have one); give the waypoints with --waypoints 'x,y[,yaw];...'")
 
 
 def _progress_line(now: float, nav: Any, monitor: _Monitor, waypoints: list[Any], probe: _PeriodProbe, rtf: float,
