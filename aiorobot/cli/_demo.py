@@ -2,8 +2,9 @@
 
 ``--world`` is a built-in name (``warehouse``, ``box``: each has a shipped mission) or a map
 YAML path (a Nav2 map, say: a path is always a path, whatever its name, and needs
-``--waypoints``). Exit status: 0 when every waypoint was reached without collision; 1
-otherwise; 2 for bad arguments or a bad world; 130 on Ctrl-C.
+``--waypoints``). Exit status: 0 when every waypoint was reached, or the run reached its
+``--duration``, without collision or failed node; 1 otherwise; 2 for bad arguments or a bad
+world; 130 on Ctrl-C.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import math
 import sys
 from pathlib import Path
 
-from ._parser import accept_negative_number_lists
+from ._parser import accept_negative_number_lists, positive_seconds
 from ._sim import start_pose
 
 __all__ = ["add_arguments", "main", "run_as_default"]
@@ -34,7 +35,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "The simulated mecanum robot follows a waypoint mission: simulator (lidar, IMU, wheel odometry), AMCL "
         "localisation on the map, costmap + A* + Regulated Pure Pursuit navigation with recoveries. Prints progress "
-        "and a summary against ground truth; exit status 0 only when every waypoint was reached without collision."
+        "and a summary against ground truth; exit status 0 when every waypoint was reached, or the run reached its "
+        "--duration, without collision or failed node."
     )
     parser.add_argument("--world", default="warehouse", metavar="NAME|PATH",
                         help="built-in world (warehouse, box) or a map YAML path, such as a Nav2 map (needs --waypoints)")
@@ -43,6 +45,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--start", type=start_pose, metavar="X,Y[,YAW]",
                         help="start pose in map (m, m, rad); default: the world's start, or on a map whose start is "
                         "blocked (a Nav2 map's origin) the free cell nearest to it, with a warning")
+    parser.add_argument("--duration", type=positive_seconds, metavar="SIM_SEC",
+                        help="stop after this much sim time; a run stopped so, without collision, is not a failure")
     parser.add_argument("--rtf", type=_rtf, default=0.0, help="real-time factor (default 0: as fast as the machine allows)")
     parser.add_argument("--time-source", choices=("sim", "system"), default=None,
                         help="system: the simulator stamps with system time and every node runs on the system clock, "
@@ -50,7 +54,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "(default: system at --rtf 1, else sim)")
     parser.add_argument("--seed", type=int, default=1, help="seed of every noise model (default 1)")
     parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC",
-                        help="give up after this much sim time (default 600)")
+                        help="give up after this much sim time, a failure (default 600)")
     parser.add_argument("--drive", choices=("serial", "direct"), default=None,
                         help="serial: the mecanum base through the simulated ESP32 firmware on a pty (SerialMotorBridge + "
                         "MecanumController), which runs on the wall clock and so needs --rtf > 0; direct: the simulator "
@@ -71,10 +75,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_as_default(duration_sec: float | None = None) -> int:
-    """``aiorobot run`` without a file: the demo with its defaults (``duration_sec`` limits sim time)."""
+    """``aiorobot run`` without a file: the demo with its defaults (``duration_sec`` is its ``--duration``)."""
     parser = argparse.ArgumentParser(prog="aiorobot demo")
     add_arguments(parser)
-    return main(parser.parse_args([] if duration_sec is None else ["--timeout", repr(float(duration_sec))]))
+    return main(parser.parse_args([] if duration_sec is None else ["--duration", repr(float(duration_sec))]))
 
 
 def main(args: argparse.Namespace) -> int:
@@ -121,15 +125,15 @@ def main(args: argparse.Namespace) -> int:
         print(f"aiorobot demo: warning: {start.warning}", file=sys.stderr)
     print(f"aiorobot demo: {args.world}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
           f"{args.localisation} localisation, seed {args.seed}, "
-          f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time "
-          "(Ctrl-C stops)", file=sys.stderr)
+          f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time"
+          f"{f', {args.duration:g} sim s' if args.duration else ''} (Ctrl-C stops)", file=sys.stderr)
     try:
         summary = aiorobot.run(run_demo(args.world, waypoints, rtf=args.rtf, seed=args.seed, drive=drive,
                                         localisation=args.localisation, perception=args.perception,
                                         record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress,
                                         time_source=args.time_source, realtime=args.realtime,
-                                        start=start.pose))
+                                        start=start.pose, duration_sim_sec=args.duration))
     except DemoSetupError as err:  # a node refused what the checks above let through (nothing started)
         print(f"aiorobot demo: error: {err}", file=sys.stderr)
         return 2
@@ -146,7 +150,7 @@ def main(args: argparse.Namespace) -> int:
 
         plot_demo(summary, args.world, waypoints, args.plot)
         print(f"plot written to {args.plot}")
-    return 0 if summary.succeeded else 1
+    return 0 if summary.passed else 1
 
 
 def _print_summary(s: object) -> None:
@@ -154,7 +158,9 @@ def _print_summary(s: object) -> None:
     from rich.table import Table
 
     f = s.figures()  # type: ignore[attr-defined]
-    table = Table(title=f"aiorobot demo — {f['world']}, {f['drive']} drive, {f['localisation']}: {f['status']}",
+    outcome = (f"stopped after --duration: {f['waypoints_reached']} / {f['waypoints_total']} waypoints"
+               if f["stopped_by_duration"] else f["status"])
+    table = Table(title=f"aiorobot demo — {f['world']}, {f['drive']} drive, {f['localisation']}: {outcome}",
                   title_justify="left")
     table.add_column("figure")
     table.add_column("value", justify="right")
@@ -176,6 +182,8 @@ def _print_summary(s: object) -> None:
     ]
     if f["localisation"] == "landmarks":
         rows.insert(3, ("landmark fixes (with heading)", f"{f['landmark_fixes']} ({f.get('landmark_heading_fixes', 0)})"))
+    if f["failures"]:
+        rows.append(("node failures", "; ".join(f["failures"])))
     if f["record"]:
         rows.append(("recorded to", f["record"]))
     for name, value in rows:

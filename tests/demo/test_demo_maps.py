@@ -1,4 +1,4 @@
-"""``aiorobot demo`` on a map of the user's (a Nav2 map) (issue 26 item 9).
+"""``aiorobot demo`` on a map of the user's (a Nav2 map) and bounded by ``--duration`` (issues 25 item 3, 26 item 9).
 
 The map is written here, shaped like nav2_bringup's ``turtlebot3_world`` (a pillar on the origin, a
 negative origin, no ``start`` key) and named ``warehouse.yaml`` like Nav2's own warehouse map: a path
@@ -7,13 +7,16 @@ is a path, so it does not get the built-in warehouse's mission.
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from aiorobot.cli import main
-from aiorobot.demo import DemoSetupError, mission_for, run_demo
+from aiorobot.demo import DemoSetupError, DemoSummary, mission_for, run_demo
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -73,3 +76,45 @@ def test_a_nav2_map_runs_from_the_nearest_free_cell_with_one_warning(
     figures = json.loads((tmp_path / "summary.json").read_text())
     assert figures["world"] == str(path) and figures["waypoints_reached"] == 1 and figures["collisions"] == 0
     assert figures["start"] != [0.0, 0.0, 0.0]
+
+
+def test_a_run_stopped_by_its_duration_exits_0_and_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the first waypoint is 0.5 m away, the second 4.3 m beyond it: 5 sim seconds reach one, not both
+    status = main(["demo", "--world", "box", "--waypoints", "0.5,0;-2.5,2.5", "--duration", "5", "--rtf", "0",
+                   "--no-perception", "--json", str(tmp_path / "summary.json")])
+    out = capsys.readouterr()
+    assert status == 0, out.err
+    assert "aiorobot demo — box, direct drive, amcl: stopped after --duration: 1 / 2 waypoints" in out.out
+    import json
+
+    figures = json.loads((tmp_path / "summary.json").read_text())
+    assert figures["stopped_by_duration"] and figures["status"] == "STOPPED" and figures["duration_sec"] == 5.0
+    assert figures["collisions"] == 0 and figures["failures"] == [] and figures["sim_sec"] >= 5.0
+
+
+def test_what_passes_the_exit_status() -> None:
+    stopped = DemoSummary(world="box", waypoints_total=3, stopped_by_duration=True)
+    assert stopped.passed and not stopped.succeeded
+    assert not DemoSummary(world="box", waypoints_total=3, stopped_by_duration=True, collisions=1).passed
+    assert not DemoSummary(world="box", waypoints_total=3, stopped_by_duration=True, failures=["/amcl: x raised"]).passed
+    assert not DemoSummary(world="box", waypoints_total=3, waypoints_reached=2).passed  # timed out: a failure
+    assert DemoSummary(world="box", waypoints_total=3, waypoints_reached=3).passed
+
+
+def test_ctrl_c_still_exits_130() -> None:
+    proc = subprocess.Popen([sys.executable, "-m", "aiorobot.cli", "demo", "--world", "box", "--rtf", "0",
+                             "--no-perception", "--duration", "500"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stderr is not None
+        for line in proc.stderr:  # not a terminal: one progress line at a time, once the mission runs
+            if line.startswith("sim "):
+                break
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "aiorobot demo: interrupted" in err
