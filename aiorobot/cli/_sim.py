@@ -73,14 +73,14 @@ def main(args: argparse.Namespace) -> int:
                   "duration_sec": args.duration or 0.0}
     if args.start is not None:
         parameters["start"] = list(args.start)
-    from ._logging import configure_logging
-
-    configure_logging("info")  # before the simulator: it warns when it moves a blocked start
-    try:
+    try:  # a start it has to move is a warning through the node loggers' default handler (stderr)
         simulator = Simulator(parameter_overrides=parameters)
     except (WorldError, ValueError, aiorobot.InvalidParameterValueError) as err:
         print(f"aiorobot sim: error: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    from ._logging import configure_logging
+
+    configure_logging("info")
     try:
         return aiorobot.run(_serve(simulator, args.status_period))
     except KeyboardInterrupt:
