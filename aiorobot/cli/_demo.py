@@ -160,8 +160,9 @@ def _print_summary(s: object) -> None:
     f = s.figures()  # type: ignore[attr-defined]
     outcome = (f"stopped after --duration: {f['waypoints_reached']} / {f['waypoints_total']} waypoints"
                if f["stopped_by_duration"] else f["status"])
-    table = Table(title=f"aiorobot demo — {f['world']}, {f['drive']} drive, {f['localisation']}: {outcome}",
-                  title_justify="left")
+    world = Path(f["world"]).name  # a map path by its file name
+    title = f"aiorobot demo — {world}, {f['drive']} drive, {f['localisation']}: {outcome}"
+    table = Table()
     table.add_column("figure")
     table.add_column("value", justify="right")
     rows = [
@@ -188,7 +189,9 @@ def _print_summary(s: object) -> None:
         rows.append(("recorded to", f["record"]))
     for name, value in rows:
         table.add_row(name, value)
-    Console(width=110).print(table)
+    console = Console(width=max(110, len(title)))
+    console.print(title, markup=False, highlight=False)  # its own line: a table title wraps at the table's width
+    console.print(table)
 
 
 def _control_text(f: dict) -> str:
