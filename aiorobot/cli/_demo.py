@@ -1,4 +1,11 @@
-"""``aiorobot demo``: the simulated mecanum robot navigating a waypoint mission, with a summary."""
+"""``aiorobot demo``: the simulated mecanum robot navigating a waypoint mission, with a summary.
+
+``--world`` is a built-in name (``warehouse``, ``box``: each has a shipped mission) or a map
+YAML path (a Nav2 map, say: a path is always a path, whatever its name, and needs
+``--waypoints``). Exit status: 0 when every waypoint was reached, or the run reached its
+``--duration``, without collision or failed node; 1 otherwise; 2 for bad arguments or a bad
+world; 130 on Ctrl-C.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +14,9 @@ import json
 import math
 import sys
 from pathlib import Path
+
+from ._parser import accept_negative_number_lists, positive_seconds
+from ._sim import start_pose
 
 __all__ = ["add_arguments", "main", "run_as_default"]
 
@@ -25,17 +35,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "The simulated mecanum robot follows a waypoint mission: simulator (lidar, IMU, wheel odometry), AMCL "
         "localisation on the map, costmap + A* + Regulated Pure Pursuit navigation with recoveries. Prints progress "
-        "and a summary against ground truth; exit status 0 only when every waypoint was reached without collision."
+        "and a summary against ground truth; exit status 0 when every waypoint was reached, or the run reached its "
+        "--duration, without collision or failed node."
     )
-    parser.add_argument("--world", default="warehouse", metavar="NAME|PATH", help="built-in world (warehouse, box) or a map YAML")
-    parser.add_argument("--waypoints", metavar="'x,y[,yaw];...'", help="a mission of your own (default: the world's shipped one)")
+    parser.add_argument("--world", default="warehouse", metavar="NAME|PATH",
+                        help="built-in world (warehouse, box) or a map YAML path, such as a Nav2 map (needs --waypoints)")
+    parser.add_argument("--waypoints", metavar="'x,y[,yaw];...'",
+                        help="a mission of your own (default: a built-in world's shipped one)")
+    parser.add_argument("--start", type=start_pose, metavar="X,Y[,YAW]",
+                        help="start pose in map (m, m, rad); default: the world's start, or on a map whose start is "
+                        "blocked (a Nav2 map's origin) the free cell nearest to it, with a warning")
+    parser.add_argument("--duration", type=positive_seconds, metavar="SIM_SEC",
+                        help="stop after this much sim time; a run stopped so, without collision, is not a failure")
     parser.add_argument("--rtf", type=_rtf, default=0.0, help="real-time factor (default 0: as fast as the machine allows)")
     parser.add_argument("--time-source", choices=("sim", "system"), default=None,
                         help="system: the simulator stamps with system time and every node runs on the system clock, "
                         "as on a robot (needs --rtf 1); sim: every node follows the simulator's /clock "
                         "(default: system at --rtf 1, else sim)")
     parser.add_argument("--seed", type=int, default=1, help="seed of every noise model (default 1)")
-    parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC", help="give up after this much sim time (default 600)")
+    parser.add_argument("--timeout", type=float, default=600.0, metavar="SIM_SEC",
+                        help="give up after this much sim time, a failure (default 600)")
     parser.add_argument("--drive", choices=("serial", "direct"), default=None,
                         help="serial: the mecanum base through the simulated ESP32 firmware on a pty (SerialMotorBridge + "
                         "MecanumController), which runs on the wall clock and so needs --rtf > 0; direct: the simulator "
@@ -52,28 +71,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="record the run's topics (raw camera frames excluded) into a rosbag2 directory with MCAP storage")
     parser.add_argument("--json", type=Path, metavar="FILE", help="write the summary's figures as JSON")
     parser.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the map with true, estimated and planned paths")
+    accept_negative_number_lists(parser)
 
 
 def run_as_default(duration_sec: float | None = None) -> int:
-    """``aiorobot run`` without a file: the demo with its defaults (``duration_sec`` limits sim time)."""
+    """``aiorobot run`` without a file: the demo with its defaults (``duration_sec`` is its ``--duration``)."""
     parser = argparse.ArgumentParser(prog="aiorobot demo")
     add_arguments(parser)
-    return main(parser.parse_args([] if duration_sec is None else ["--timeout", repr(float(duration_sec))]))
+    return main(parser.parse_args([] if duration_sec is None else ["--duration", repr(float(duration_sec))]))
 
 
 def main(args: argparse.Namespace) -> int:
     import aiorobot
-    from aiorobot.demo import MISSIONS, parse_waypoints, run_demo
-    from aiorobot.sim import World, WorldError
+    from aiorobot.demo import DemoSetupError, mission_for, parse_waypoints, run_demo
+    from aiorobot.demo._graph import ROBOT_RADIUS
+    from aiorobot.demo._mission import no_mission_message
+    from aiorobot.sim import World, WorldError, resolve_start
 
     try:
         world = World.load(args.world)
-        waypoints = parse_waypoints(args.waypoints) if args.waypoints else MISSIONS.get(world.name)
+        waypoints = parse_waypoints(args.waypoints) if args.waypoints else mission_for(args.world)
         if waypoints is None:
-            raise ValueError(f"world {args.world!r} has no shipped mission; give one with --waypoints 'x,y[,yaw];...'")
+            raise ValueError(no_mission_message(args.world))
         for i, (x, y, _) in enumerate(waypoints):
-            if not world.is_free_disc(x, y, 0.22):
-                raise ValueError(f"waypoint {i + 1} ({x:g}, {y:g}) is outside the map or inside an obstacle of {world.name}")
+            if not world.is_free_disc(x, y, ROBOT_RADIUS):
+                raise ValueError(f"waypoint {i + 1} ({x:g}, {y:g}) is outside the map or inside an obstacle of {args.world}")
+        start = resolve_start(world, args.start, ROBOT_RADIUS)
         drive = args.drive or ("serial" if args.rtf > 0 else "direct")
         if drive == "serial" and args.rtf == 0:
             raise ValueError("--drive serial needs --rtf > 0 (the simulated firmware's pty runs on the wall clock); "
@@ -98,16 +121,22 @@ def main(args: argparse.Namespace) -> int:
         sys.stderr.flush()
 
     time_source = args.time_source or ("system" if args.rtf == 1 else "sim")
-    print(f"aiorobot demo: {world.name}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
+    if start.warning is not None:
+        print(f"aiorobot demo: warning: {start.warning}", file=sys.stderr)
+    print(f"aiorobot demo: {args.world}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
           f"{args.localisation} localisation, seed {args.seed}, "
-          f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time "
-          "(Ctrl-C stops)", file=sys.stderr)
+          f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time"
+          f"{f', {args.duration:g} sim s' if args.duration else ''} (Ctrl-C stops)", file=sys.stderr)
     try:
         summary = aiorobot.run(run_demo(args.world, waypoints, rtf=args.rtf, seed=args.seed, drive=drive,
                                         localisation=args.localisation, perception=args.perception,
                                         record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress,
-                                        time_source=args.time_source, realtime=args.realtime))
+                                        time_source=args.time_source, realtime=args.realtime,
+                                        start=start.pose, duration_sim_sec=args.duration))
+    except DemoSetupError as err:  # a node refused what the checks above let through (nothing started)
+        print(f"aiorobot demo: error: {err}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("\naiorobot demo: interrupted", file=sys.stderr)
         return 130
@@ -121,7 +150,7 @@ def main(args: argparse.Namespace) -> int:
 
         plot_demo(summary, args.world, waypoints, args.plot)
         print(f"plot written to {args.plot}")
-    return 0 if summary.succeeded else 1
+    return 0 if summary.passed else 1
 
 
 def _print_summary(s: object) -> None:
@@ -129,8 +158,11 @@ def _print_summary(s: object) -> None:
     from rich.table import Table
 
     f = s.figures()  # type: ignore[attr-defined]
-    table = Table(title=f"aiorobot demo — {f['world']}, {f['drive']} drive, {f['localisation']}: {f['status']}",
-                  title_justify="left")
+    outcome = (f"stopped after --duration: {f['waypoints_reached']} / {f['waypoints_total']} waypoints"
+               if f["stopped_by_duration"] else f["status"])
+    world = Path(f["world"]).name  # a map path by its file name
+    title = f"aiorobot demo — {world}, {f['drive']} drive, {f['localisation']}: {outcome}"
+    table = Table()
     table.add_column("figure")
     table.add_column("value", justify="right")
     rows = [
@@ -151,11 +183,15 @@ def _print_summary(s: object) -> None:
     ]
     if f["localisation"] == "landmarks":
         rows.insert(3, ("landmark fixes (with heading)", f"{f['landmark_fixes']} ({f.get('landmark_heading_fixes', 0)})"))
+    if f["failures"]:
+        rows.append(("node failures", "; ".join(f["failures"])))
     if f["record"]:
         rows.append(("recorded to", f["record"]))
     for name, value in rows:
         table.add_row(name, value)
-    Console(width=110).print(table)
+    console = Console(width=max(110, len(title)))
+    console.print(title, markup=False, highlight=False)  # its own line: a table title wraps at the table's width
+    console.print(table)
 
 
 def _control_text(f: dict) -> str:

@@ -4,9 +4,15 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 from typing import NoReturn
 
-__all__ = ["ArgumentParser", "positive_seconds"]
+__all__ = ["ArgumentParser", "accept_negative_number_lists", "positive_seconds"]
+
+_NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+#: what argparse's own test for a negative number (``-1``, ``-.5``) misses: lists such as ``-0.55,-0.55``
+#: and ``-1,0;2,1.57``, separated by commas, semicolons or spaces
+_NEGATIVE_NUMBER_LIST = re.compile(rf"^-{_NUMBER}(?:\s*[,;]?\s*-?{_NUMBER})*\s*;?\s*$")
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -14,6 +20,16 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def accept_negative_number_lists(parser: argparse.ArgumentParser) -> None:
+    """Let an option's value start with a minus sign: ``--start -1,-2,0``, ``--waypoints "-0.55,-0.55"``.
+
+    argparse takes ``-1`` and ``-.5`` for values but anything else that starts with ``-`` for an
+    option, so ``--waypoints -0.55,-0.55`` failed with "expected one argument". ``parser`` must
+    have no option that itself looks like a negative number (argparse's own rule).
+    """
+    parser._negative_number_matcher = _NEGATIVE_NUMBER_LIST  # type: ignore[attr-defined]
 
 
 def positive_seconds(text: str) -> float:

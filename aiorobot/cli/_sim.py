@@ -1,7 +1,9 @@
-"""``aiorobot sim [--world box] [--robot mecanum] [--duration SEC] [--rtf R] [--seed N]``: run the simulator alone.
+"""``aiorobot sim [--world box] [--start X,Y,YAW] [--robot mecanum] [--duration SEC] [--rtf R] [--seed N]``.
 
 A config-free start of ``aiorobot.sim:Simulator`` on a sim-time runtime: it prints a
 status line while it runs and a summary at the end. ``--duration`` counts sim seconds.
+``--world`` is a built-in name (``box``, ``warehouse``) or a map_server YAML path (a Nav2
+map: without ``--start`` the robot starts on the free cell nearest the origin, with a warning).
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ import argparse
 import math
 import sys
 
-from ._parser import positive_seconds
+from ._parser import accept_negative_number_lists, positive_seconds
 
 __all__ = ["add_arguments", "main"]
 
@@ -34,12 +36,25 @@ def _seed(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected an integer seed, found {text!r}") from None
 
 
+def start_pose(text: str) -> tuple[float, float, float]:
+    """argparse ``type=`` for ``--start X,Y[,YAW]``."""
+    from aiorobot.sim import parse_start
+
+    try:
+        return parse_start(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.description = (
         "Run the simulated robot (lidar, IMU, wheel odometry, camera, ground truth) in a world "
         "without a config file. Drive it by publishing geometry_msgs/Twist on /cmd_vel."
     )
     parser.add_argument("--world", default="box", help="built-in world (box, warehouse) or a map YAML path (default: box)")
+    parser.add_argument("--start", type=start_pose, metavar="X,Y[,YAW]",
+                        help="start pose in map (m, m, rad); default: the world's start, or on a map whose start is "
+                        "blocked (a Nav2 map's origin) the free cell nearest to it, with a warning")
     parser.add_argument("--robot", default="mecanum", choices=("mecanum", "diff"), help="drive (default: mecanum)")
     parser.add_argument("--duration", type=positive_seconds, metavar="SEC", help="stop after this many sim seconds")
     parser.add_argument("--rtf", type=_non_negative_factor, default=1.0, metavar="R",
@@ -47,6 +62,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=_seed, default=1, help="seed of every noise model (default: 1)")
     parser.add_argument("--status-period", type=positive_seconds, default=1.0, metavar="SEC",
                         help="wall seconds between status lines (default: 1)")
+    accept_negative_number_lists(parser)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -55,7 +71,9 @@ def main(args: argparse.Namespace) -> int:
 
     parameters = {"world": args.world, "robot": args.robot, "seed": args.seed, "real_time_factor": args.rtf,
                   "duration_sec": args.duration or 0.0}
-    try:
+    if args.start is not None:
+        parameters["start"] = list(args.start)
+    try:  # a start it has to move is a warning through the node loggers' default handler (stderr)
         simulator = Simulator(parameter_overrides=parameters)
     except (WorldError, ValueError, aiorobot.InvalidParameterValueError) as err:
         print(f"aiorobot sim: error: {err}", file=sys.stderr)

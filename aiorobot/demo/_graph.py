@@ -17,13 +17,15 @@ import tempfile
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["DRIVES", "LOCALISATIONS", "DemoGraph", "build_graph", "time_source_for"]
+__all__ = ["DRIVES", "LOCALISATIONS", "ROBOT_RADIUS", "DemoGraph", "build_graph", "time_source_for"]
 
 #: ``direct``: the simulator follows /cmd_vel (lock-step possible); ``serial``: the simulated
 #: ESP32 firmware on a pty, through SerialMotorBridge and MecanumController (real time only).
 DRIVES = ("direct", "serial")
 #: ``amcl``: the particle filter on the lidar; ``landmarks``: ArUco fixes into the map-frame EKF.
 LOCALISATIONS = ("amcl", "landmarks")
+#: The simulated robot's footprint radius (m): the simulator's default, what a start or a waypoint must leave free.
+ROBOT_RADIUS = 0.22
 #: Rate of the priority loop's control timer (the base controller, or the odom EKF with direct drive).
 CONTROL_HZ = 50.0
 
@@ -89,15 +91,20 @@ def build_graph(
     perception: bool,
     record: str | None = None,
     time_source: str | None = None,
+    start: tuple[float, float, float] | None = None,
 ) -> DemoGraph:
     """Construct the demo's nodes (not yet added to a runtime) for ``world`` (a loaded World).
+
+    ``start`` (x, y, yaw in map) is where the robot starts and where localisation begins; None
+    takes :func:`~aiorobot.sim.resolve_start`'s choice (the world's start, or the free cell
+    nearest it).
 
     ``time_source`` (``sim`` or ``system``, the simulator's parameter) defaults to
     :func:`time_source_for` ``(rtf)``; the runtime must use sim time exactly when it is ``sim``.
     """
     from aiorobot.fusion import EkfNode
     from aiorobot.nav import AmclNode, LandmarkFixNode, NavigationServer
-    from aiorobot.sim import Simulator
+    from aiorobot.sim import Simulator, resolve_start
 
     if drive not in DRIVES:
         raise ValueError(f"drive: expected one of {', '.join(DRIVES)}, found {drive!r}")
@@ -113,12 +120,14 @@ def build_graph(
     if time_source == "system" and rtf != 1.0:
         raise ValueError(f"time_source 'system' needs a real-time factor of exactly 1 (stamps are system time), "
                          f"found {rtf:g}; use time_source 'sim'")
+    start = resolve_start(world, start, ROBOT_RADIUS).pose  # checked whether given or not
     g = DemoGraph(time_source=time_source_for(rtf) if time_source is None else time_source)
     world_ref = str(world.path) if world.path else world.name
     sim_params: dict[str, Any] = {
         "world": world_ref, "robot": "mecanum", "seed": seed, "real_time_factor": rtf,
         "publish_odom_tf": False, "camera_rate": 15.0 if perception else 0.0,
         "drive": "serial" if drive == "serial" else "cmd_vel", "time_source": g.time_source,
+        "start": list(start), "robot_radius": ROBOT_RADIUS,
     }
     if drive == "serial":
         g.port_link = os.path.join(tempfile.gettempdir(), f"aiorobot-demo-motors-{os.getpid()}")
@@ -136,11 +145,11 @@ def build_graph(
         g.control_node = g.add(MecanumController(parameter_overrides={
             "publish_tf": False, "rate_hz": CONTROL_HZ, "max_linear_x": 0.6, "max_linear_y": 0.6}), "priority")
     ekf_local = g.add(EkfNode("ekf_local", namespace="local",
-                              parameter_overrides=_ekf_parameters("odom", pose=False, start=world.start)), "priority")
+                              parameter_overrides=_ekf_parameters("odom", pose=False, start=start)), "priority")
     if g.control_node is None:
         g.control_node = ekf_local
     if localisation == "amcl":
-        sx, sy, syaw = world.start
+        sx, sy, syaw = start
         g.add(AmclNode(parameter_overrides={
             "robot_model_type": "omnidirectional", "set_initial_pose": True,
             "initial_pose.x": sx, "initial_pose.y": sy, "initial_pose.yaw": syaw,
@@ -150,7 +159,7 @@ def build_graph(
     else:
         g.landmark_fixes = g.add(LandmarkFixNode(parameter_overrides={"world": world_ref, "max_range_m": 6.0}))
         g.add(EkfNode("ekf_global", namespace="global",
-                      parameter_overrides=_ekf_parameters("map", pose=True, start=world.start)), "priority")
+                      parameter_overrides=_ekf_parameters("map", pose=True, start=start)), "priority")
     if perception:
         from aiorobot.perception import ArucoNode, ScanObstacleNode
 

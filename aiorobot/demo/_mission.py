@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import gc
+import logging
 import math
 import threading
 import time
@@ -13,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MISSIONS", "DemoSummary", "parse_waypoints", "run_demo"]
+__all__ = ["MISSIONS", "DemoSetupError", "DemoSummary", "mission_for", "parse_waypoints", "run_demo"]
 
 _PI = math.pi
 #: The shipped missions: (x, y, yaw) waypoints per built-in world.
@@ -29,6 +30,21 @@ MISSIONS: dict[str, list[tuple[float, float, float]]] = {
     ],
     "box": [(2.0, 0.0, _PI / 2), (2.0, 2.0, _PI), (-2.0, 2.0, -_PI / 2), (-2.0, -2.0, 0.0), (0.0, 0.0, 0.0)],
 }
+
+
+class DemoSetupError(ValueError):
+    """The demo cannot start with what it was given (world, start, waypoints, options); nothing was started."""
+
+
+def mission_for(world: str) -> list[tuple[float, float, float]] | None:
+    """The shipped mission of a built-in world named by its bare name; None for anything else.
+
+    A path is a path: a map file that happens to be called ``warehouse.yaml`` (Nav2 ships one)
+    is not the built-in warehouse and has no mission.
+    """
+    from aiorobot.sim import BUILTIN_WORLDS
+
+    return list(MISSIONS[world]) if world in BUILTIN_WORLDS and world in MISSIONS else None
 
 
 def parse_waypoints(text: str) -> list[tuple[float, float, float]]:
@@ -52,6 +68,7 @@ def parse_waypoints(text: str) -> list[tuple[float, float, float]]:
 class DemoSummary:
     """The demo's figures (``--json`` writes these keys)."""
 
+    #: the built-in world's name or the map YAML's path, as given
     world: str
     waypoints_reached: int = 0
     waypoints_total: int = 0
@@ -92,6 +109,13 @@ class DemoSummary:
     workers_cpu_pct: float = 0.0
     record: str | None = None
     status: str = "UNKNOWN"
+    #: where the robot started (x, y, yaw in map)
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    #: the sim-time bound of the run (``--duration``), and whether the run ended on it: not a failure
+    duration_sec: float | None = None
+    stopped_by_duration: bool = False
+    #: nodes that failed to start or whose callbacks raised ("/fqn: entity raised N times")
+    failures: list[str] = field(default_factory=list)
     missed: list[int] = field(default_factory=list)
     truth: list[tuple[float, float]] = field(default_factory=list, repr=False)
     estimate: list[tuple[float, float]] = field(default_factory=list, repr=False)
@@ -99,7 +123,14 @@ class DemoSummary:
 
     @property
     def succeeded(self) -> bool:
+        """Every waypoint reached without collision."""
         return self.waypoints_total > 0 and self.waypoints_reached == self.waypoints_total and self.collisions == 0
+
+    @property
+    def passed(self) -> bool:
+        """What the exit status says: the mission succeeded, or the run reached its ``--duration`` first;
+        either way without collision and without a failed node."""
+        return (self.succeeded or self.stopped_by_duration) and self.collisions == 0 and not self.failures
 
     def figures(self) -> dict[str, Any]:
         d = asdict(self)
@@ -271,6 +302,8 @@ async def run_demo(
     record: str | None = None,
     time_source: str | None = None,
     realtime: bool = False,
+    start: tuple[float, float, float] | None = None,
+    duration_sim_sec: float | None = None,
 ) -> DemoSummary:
     """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows.
 
@@ -285,24 +318,38 @@ async def run_demo(
     ``record`` is a directory for a rosbag2/MCAP bag of the run's topics (raw images excluded).
     ``realtime`` runs the priority loop's thread SCHED_FIFO where the OS permits it (as ros2_control's
     controller manager does); otherwise a warning, and the run goes on.
+
+    ``world`` is a built-in name or a map YAML path; only a built-in name has a shipped mission
+    (:func:`mission_for`), so a path needs ``waypoints``. ``start`` (x, y, yaw) is where the robot
+    starts; None takes the world's start, or the free cell nearest it with a logged warning (a
+    Nav2 map's origin is often blocked). ``duration_sim_sec`` ends the run after that much sim
+    time: ``stopped_by_duration``, which is not a failure; ``timeout_sim_sec`` ends it as one.
     """
     from aiorobot import Node, Runtime
     from aiorobot.nav import Navigator, TaskResult, pose_stamped
-    from aiorobot.sim import World
+    from aiorobot.sim import World, resolve_start
 
-    from ._graph import build_graph
+    from ._graph import ROBOT_RADIUS, build_graph
 
-    loaded = World.load(world)
-    if waypoints is None:
-        if loaded.name not in MISSIONS:
-            raise ValueError(f"world {world!r} has no shipped mission; give one with --waypoints 'x,y[,yaw];...'")
-        waypoints = MISSIONS[loaded.name]
+    world = str(world)
     if drive is None:
         drive = "serial" if rtf > 0 else "direct"
-    graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
-                        record=record, time_source=time_source)
-    summary = DemoSummary(world=loaded.name, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
-                          localisation=localisation, time_source=graph.time_source)
+    try:  # everything that can refuse the input, before anything starts
+        loaded = World.load(world)
+        if waypoints is None:
+            waypoints = mission_for(world)
+            if waypoints is None:
+                raise ValueError(no_mission_message(world))
+        choice = resolve_start(loaded, start, ROBOT_RADIUS)
+        graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
+                            record=record, time_source=time_source, start=choice.pose)
+    except ValueError as err:  # WorldError and the nodes' parameter errors among them
+        raise DemoSetupError(str(err)) from err
+    if choice.warning is not None:
+        logging.getLogger("aiorobot.demo").warning(choice.warning)
+    summary = DemoSummary(world=world, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
+                          localisation=localisation, time_source=graph.time_source, start=choice.pose,
+                          duration_sec=duration_sim_sec)
     # What exists now (imported modules, Numba's and the simulator's start-up objects: most of the heap) is
     # left out of the cyclic collector's full passes: such a pass stops every thread, the priority loop's
     # included, for as long as it walks the heap (66 ms seen in the warehouse at --rtf 1; ~1 ms after this).
@@ -328,6 +375,10 @@ async def run_demo(
             while not (started.done() and nav.is_task_complete()):
                 await asyncio.sleep(0.05)
                 now = sim.time_ns / 1e9  # the simulator's elapsed time, on either time source
+                if duration_sim_sec is not None and now >= duration_sim_sec and duration_sim_sec <= timeout_sim_sec:
+                    summary.stopped_by_duration = True
+                    await nav.cancel_task()
+                    break
                 if now > timeout_sim_sec:
                     await nav.cancel_task()
                     break
@@ -349,6 +400,9 @@ async def run_demo(
             summary.status = status.name if summary.status != "REJECTED" else summary.status
             if status is TaskResult.SUCCEEDED:
                 summary.waypoints_reached = len(waypoints) - len(summary.missed)
+            elif nav.get_feedback() is not None:  # stopped on the way: the waypoints before the current one
+                current = int(nav.get_feedback().current_waypoint)
+                summary.waypoints_reached = current - sum(1 for m in summary.missed if m < current)
             summary.collisions = sim.body.collisions
             summary.recoveries = server.recoveries
             summary.sim_sec = sim.time_ns / 1e9
@@ -376,6 +430,9 @@ async def run_demo(
                     summary.baseline_period_p99_ms = float(np.percentile(base, 99))
                     summary.baseline_period_max_ms = float(base.max())
     gc.unfreeze()
+    summary.failures = _failures(rt)
+    if summary.stopped_by_duration:
+        summary.status = "STOPPED"
     summary.wall_sec = time.perf_counter() - wall0
     summary.cpu_pct = 100.0 * (time.process_time() - cpu0) / max(summary.wall_sec, 1e-9)
     summary.workers_cpu_pct = 100.0 * child_cpu / max(summary.wall_sec, 1e-9)
@@ -383,6 +440,25 @@ async def run_demo(
     if graph.recorder is not None:
         summary.record = graph.recorder.path
     return summary
+
+
+def no_mission_message(world: str) -> str:
+    """The one line for a world without a shipped mission and no waypoints given."""
+    from aiorobot.sim import BUILTIN_WORLDS
+
+    return (f"world {world!r} has no shipped mission (only the built-in worlds {', '.join(BUILTIN_WORLDS)}, named "
+            "without a path, have one); give the waypoints with --waypoints 'x,y[,yaw];...'")
+
+
+def _failures(rt: Any) -> list[str]:
+    """One line per node that failed to start or whose callbacks raised (as ``aiorobot run`` reports them)."""
+    stats = rt.statistics()
+    lines = [f"{fqn}: failed to start (on_start raised)" for fqn in stats["failed_starts"]]
+    for (fqn, entity), count in sorted(stats["failures"].items()):
+        if entity == "on_start" and fqn in stats["failed_starts"]:
+            continue
+        lines.append(f"{fqn}: {entity} raised {count} time{'s' if count != 1 else ''}")
+    return lines
 
 
 def _progress_line(now: float, nav: Any, monitor: _Monitor, waypoints: list[Any], probe: _PeriodProbe, rtf: float,

@@ -43,7 +43,7 @@ def plot_demo(summary: Any, world_name: str, waypoints: list[tuple[float, float,
         missed = i in summary.missed
         ax.plot(x, y, marker="x" if missed else "o", color="tab:red", markersize=9, fillstyle="none")
         ax.annotate(f"{i + 1}", (x, y), textcoords="offset points", xytext=(6, -10), fontsize=9, color="tab:red")
-    sx, sy, _ = world.start
+    sx, sy, _ = summary.start
     ax.plot(sx, sy, marker="^", color="black", markersize=9, label="start")
     ax.set_title(
         f"aiorobot demo — {world.name}: {summary.waypoints_reached}/{summary.waypoints_total} waypoints, "

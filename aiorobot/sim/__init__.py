@@ -3,7 +3,8 @@
 Pure cores, usable without a runtime: :class:`World` (map_server YAML + image plus
 ArUco landmarks; built-ins ``box`` and ``warehouse``), :func:`raycast` (Numba),
 :class:`LidarModel`, :class:`ImuModel`, :class:`RobotBody`, :class:`CameraModel`,
-:class:`MarkerRenderer`, :func:`project_landmark`.
+:class:`MarkerRenderer`, :func:`project_landmark`, :func:`resolve_start` (the start pose, or the
+free cell nearest the world's start when that is blocked, as on a Nav2 map).
 
 The node: :class:`Simulator` (``use = "aiorobot.sim:Simulator"``).
 """
@@ -15,6 +16,7 @@ from ._camera import OPTICAL_FROM_LINK, CameraModel, MarkerRenderer, camera_pose
 from ._raycast import clearance_map, raycast
 from ._robot import RobotBody, make_kinematics
 from ._sensors import GRAVITY, ImuModel, LidarModel
+from ._start import StartChoice, nearest_free_spot, parse_start, resolve_start
 from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TIME_SOURCES, TOPICS, Simulator
 from ._world import BUILTIN_WORLDS, Landmark, World, WorldError, builtin_world_path
 from ._world_file import load_world, save_world
@@ -35,6 +37,7 @@ __all__ = [
     "OPTICAL_FROM_LINK",
     "RobotBody",
     "Simulator",
+    "StartChoice",
     "TIME_SOURCES",
     "TOPICS",
     "World",
@@ -46,7 +49,10 @@ __all__ = [
     "make_box",
     "make_kinematics",
     "make_warehouse",
+    "nearest_free_spot",
+    "parse_start",
     "project_landmark",
     "raycast",
+    "resolve_start",
     "save_world",
 ]

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from aiorobot import Node, QoSProfile, compile_kernels
+from aiorobot import Node, Parameter, QoSProfile, compile_kernels
 from aiorobot._qos import DurabilityPolicy
 
 from ._camera import CameraModel, MarkerRenderer, camera_pose_matrix
@@ -30,6 +30,7 @@ from ._messages import occupancy_grid_message, odometry_message, static_transfor
 from ._raycast import raycast
 from ._robot import RobotBody, make_kinematics
 from ._sensors import ImuModel, LidarModel
+from ._start import resolve_start
 from ._world import World
 
 __all__ = ["CAMERA_XYZ", "FRAMES", "IMU_XYZ", "LASER_XYZ", "TIME_SOURCES", "TOPICS", "Simulator"]
@@ -102,6 +103,10 @@ class Simulator(Node):
     ----------------------------------------------------------
     world : str
         A built-in world (``box``, ``warehouse``) or a path to a map YAML.
+    start : double array
+        ``[x, y, yaw]`` (m, m, rad) in map: where the robot starts; refused when its disc is
+        blocked. Unset: the world's start (else the origin), or, when that is blocked or in
+        unknown space (a Nav2 map), the known-free cell nearest to it, with a warning.
     robot : str
         ``mecanum`` or ``diff``; geometry from ``wheel_radius``, ``wheel_separation`` (diff),
         ``half_length`` and ``half_width`` (mecanum), as in ``aiorobot.control``.
@@ -123,6 +128,8 @@ class Simulator(Node):
         super().__init__("simulator", **kw)
         p = self.declare_parameter
         world_name = p("world", "box", description="built-in world name or map YAML path", read_only=True).value
+        start = p("start", Parameter.Type.DOUBLE_ARRAY, description="[x, y, yaw] start in map (unset: the world's, "
+                  "or the free cell nearest it)", read_only=True).value
         robot = p("robot", "mecanum", description="drive: mecanum or diff", read_only=True).value
         seed = p("seed", 1, description="seed of every noise model", read_only=True).value
         rtf = p("real_time_factor", 1.0, description="sim s per wall s; 0 = as fast as possible",
@@ -182,6 +189,11 @@ class Simulator(Node):
         if not 0.0 <= noise["wheel_slip"] < 1.0:
             raise ValueError(f"wheel_slip: expected a fraction in [0, 1), found {noise['wheel_slip']!r}")
         self.world = World.load(world_name)
+        choice = resolve_start(self.world, start, radius)
+        #: the robot's start pose in map (x, y, yaw)
+        self.start = choice.pose
+        if choice.warning is not None:
+            self.get_logger().warning(choice.warning)
         self.real_time_factor = float(rtf)
         self.seed = int(seed)
         streams = np.random.SeedSequence(self.seed).spawn(4)
@@ -189,13 +201,10 @@ class Simulator(Node):
         self.kinematics = make_kinematics(str(robot), **geometry)
         self.robot_kind = str(robot)
         self.body = RobotBody(
-            self.kinematics, self.world.start, radius=radius,
+            self.kinematics, self.start, radius=radius,
             max_acceleration=(accel[0], accel[0], accel[1]), wheel_slip=noise["wheel_slip"],
             odom_scale_error=noise["odom_scale_error"], odom_noise_std=noise["odom_noise_std"], rng=self._rng_odom,
         )
-        if not self.world.is_free_disc(self.world.start[0], self.world.start[1], radius):
-            raise ValueError(f"{self.world.path or self.world.name}: start {self.world.start} is inside an obstacle "
-                             f"for robot_radius={radius}; move the start or shrink the robot")
         self.odom_noise_std = noise["odom_noise_std"]
         self.lidar = LidarModel(noise_std=noise["scan_noise_std"])
         self.imu = ImuModel(gyro_noise_std=noise["gyro_noise_std"], gyro_bias_std=noise["gyro_bias_std"],
@@ -518,7 +527,7 @@ class Simulator(Node):
 
     def summary(self) -> str:
         x, y, yaw = self.body.pose
-        ex, ey, _ = self.body.odom_error(self.world.start)
+        ex, ey, _ = self.body.odom_error(self.start)
         return (
             f"{self.get_name()}: {self.time_ns / _NS:.2f} s of sim time in {self.wall_elapsed_sec:.2f} s "
             f"({self.achieved_real_time_factor:.1f}x), {self.commands_received} cmd_vel "
