@@ -1,9 +1,10 @@
 """``Player``: plays a rosbag2 directory back into a graph, paced like the recording.
 
-Messages are published in time order with the recorded spacing divided by ``rate``. With
-``clock`` the player also publishes ``/clock`` (rosgraph_msgs/Clock) carrying the playback
-time, at ``clock_hz`` between messages and exactly at each message's recorded time just
-before it is published, so nodes on sim time see ``now()`` equal to the recorded stamp.
+Messages are published in time order with the recorded spacing divided by ``rate``, from the
+first message on (``metadata.yaml``'s ``starting_time`` may be later than it). With ``clock``
+the player also publishes ``/clock`` (rosgraph_msgs/Clock) carrying the playback time, at
+``clock_hz`` between messages and exactly at each message's recorded time just before it is
+published, so nodes on sim time see ``now()`` equal to the recorded stamp.
 """
 
 from __future__ import annotations
@@ -99,7 +100,7 @@ class Player(Node):
                 continue
             msg_type = self.reader.message_type(info.name)
             if msg_type is None:
-                self.get_logger().warning(f"{info.name}: type {info.type} is unknown; its {info.message_count} messages are skipped")
+                self.get_logger().warning(f"{info.name}: {self.reader.type_problem(info.name)}; its {info.message_count} messages are skipped")
                 continue
             self._types[info.name] = msg_type
             self._topic_pubs[info.name] = self.create_publisher(msg_type, self.remaps.get(info.name, info.name), info.qos)
