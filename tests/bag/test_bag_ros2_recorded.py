@@ -165,3 +165,33 @@ async def test_play_starts_at_the_first_message_even_before_metadata_starting_ti
         done.set()
     assert got == [f"Hello World: {i}" for i in range(10)]
     assert stats.published == 19 and stats.skipped == 0
+
+
+def test_reindex_of_ros2_recorded_mcap_files_reads_back_every_message(tmp_path: Path) -> None:
+    """rosbag2's reindex_test_bags/multiple_files: three whole MCAP files and no metadata.yaml."""
+    from rosbags.rosbag2 import Reader
+
+    from aiorobot.bag import reindex
+
+    bag = tmp_path / "multiple_files"
+    parts = []
+    for i, n in enumerate((5, 5, 2)):
+        part = _talker_like(tmp_path / f"part{i}", "mcap")
+        for topic in part.topics:
+            topic.messages = [(t + i * 1_000_000_000, d) for t, d in topic.messages[:n]]
+        parts.append(part)
+    bag.mkdir()
+    for i, part in enumerate(parts):  # rewrite each part's messages into multiple_files_<i>.mcap, no metadata.yaml
+        from ._ros2_bags import _write_mcap
+
+        _write_mcap(bag / f"multiple_files_{i}.mcap", part.topics)
+    before = {p.name: p.read_bytes() for p in bag.iterdir()}
+    total = sum(len(t.messages) for part in parts for t in part.topics)
+    result = reindex(bag)
+    assert (result.files, result.messages, result.damaged) == (3, total, 0)
+    assert {p.name: p.read_bytes() for p in bag.iterdir() if p.suffix == ".mcap"} == before  # whole files are left alone
+    with Reader(bag) as reader:  # rosbags' rosbag2 reader pairs metadata.yaml's QoS with the channels' by equality
+        assert sum(1 for _ in reader.messages()) == total
+    with BagReader(bag) as reader:
+        assert reader.warnings == []
+        assert sum(1 for _ in reader.messages()) == total
