@@ -195,3 +195,19 @@ def test_reindex_of_ros2_recorded_mcap_files_reads_back_every_message(tmp_path: 
     with BagReader(bag) as reader:
         assert reader.warnings == []
         assert sum(1 for _ in reader.messages()) == total
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_bag_info_of_a_ros2_recorded_bag_prints_seconds_from_the_integer_stamps(
+    tmp_path: Path, storage: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from aiorobot.cli import main
+
+    bag = _talker_like(tmp_path, storage)
+    assert main(["bag", "info", str(bag.path)]) == 0
+    out = capsys.readouterr().out
+    assert "Start:             Apr 09 2020 04:27:36.763032325 (1586406456.763032325)" in out  # a float prints ...436
+    assert "End:               Apr 09 2020 04:27:36.853032325 (1586406456.853032325)" in out
+    assert "Duration:          0.090000000s" in out
+    assert f"Storage id:        {storage}" in out and "Messages:          19" in out
+    assert f"Topic: /add/_service_event | Type: bag{storage}_srvs/srv/Add_Event | Count: 4" in out
