@@ -5,6 +5,10 @@ first message on (``metadata.yaml``'s ``starting_time`` may be later than it). W
 the player also publishes ``/clock`` (rosgraph_msgs/Clock) carrying the playback time, at
 ``clock_hz`` between messages and exactly at each message's recorded time just before it is
 published, so nodes on sim time see ``now()`` equal to the recorded stamp.
+
+The player shares the loop: it never holds it longer than ``_YIELD_NS`` while catching up on
+messages that are due, and a ``loop`` pass of a bag whose messages all share one stamp still
+gives the loop a turn, so a very short bag played with ``loop`` cannot starve it.
 """
 
 from __future__ import annotations
@@ -20,6 +24,9 @@ from ._metadata import BagError
 from ._reader import BagReader
 
 __all__ = ["Player", "PlayerStatistics", "parse_remaps"]
+
+#: The longest the player publishes due messages back to back before giving the loop a turn.
+_YIELD_NS = 2_000_000
 
 
 def parse_remaps(remaps: list[str]) -> dict[str, str]:
@@ -169,10 +176,12 @@ class Player(Node):
 
         start = self.reader.start_ns + int(self.start_offset * 1e9)
         clock_period_ns = int(1e9 / self.clock_hz)
+        turn = time.monotonic_ns()  # when the loop last had a turn
         try:
             while True:
                 wall_t0 = time.monotonic_ns()
                 last_clock = wall_t0 - clock_period_ns
+                played = self._published + self._skipped
                 for topic, t_ns, data in self.reader.messages(list(self._types), start_ns=start):
                     while True:  # pace: wait for the message's time, publishing /clock meanwhile
                         if not self._resume.is_set():
@@ -182,6 +191,9 @@ class Player(Node):
                         now = time.monotonic_ns()
                         due = wall_t0 + int((t_ns - start) / self.rate)
                         if now >= due:
+                            if now - turn >= _YIELD_NS:  # behind schedule: still let the loop run
+                                await asyncio.sleep(0)
+                                turn = time.monotonic_ns()
                             break
                         wake = due
                         if self._clock_pub is not None:
@@ -190,6 +202,7 @@ class Player(Node):
                                 last_clock = now
                             wake = min(due, last_clock + clock_period_ns)
                         await self._sleep_until_ns(wake)
+                        turn = time.monotonic_ns()
                     if self._clock_pub is not None:
                         self._publish_clock(t_ns)
                     try:
@@ -203,8 +216,10 @@ class Player(Node):
                     self._topic_pubs[topic].publish(msg)
                     self._published += 1
                 self._loops += 1
-                if not self.loop:
+                if not self.loop or self._published + self._skipped == played:  # nothing to play again
                     break
+                await asyncio.sleep(0)  # a pass may have taken no time at all: the loop gets a turn
+                turn = time.monotonic_ns()
         finally:
             self._done.set()
 

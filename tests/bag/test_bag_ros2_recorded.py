@@ -211,3 +211,24 @@ def test_bag_info_of_a_ros2_recorded_bag_prints_seconds_from_the_integer_stamps(
     assert "Duration:          0.090000000s" in out
     assert f"Storage id:        {storage}" in out and "Messages:          19" in out
     assert f"Topic: /add/_service_event | Type: bag{storage}_srvs/srv/Add_Event | Count: 4" in out
+
+
+def _one_message_bag(tmp_path: Path) -> Path:
+    from rosbags.typesys import Stores, get_typestore
+
+    jazzy = get_typestore(Stores.ROS2_JAZZY)
+    data = bytes(jazzy.serialize_cdr(jazzy.types["std_msgs/msg/String"](data="x"), "std_msgs/msg/String"))
+    return ros2_bag(tmp_path / "one", "mcap", [BagTopic("/one", "std_msgs/msg/String", "string data\n", [(T0, data)])]).path
+
+
+async def test_loop_of_a_one_message_bag_leaves_the_loop_free(tmp_path: Path) -> None:
+    """Every pass of a one-message bag is due at once: the player used to hold the loop for ever."""
+    async with Runtime(handle_signals=False) as rt:
+        player = Player(path=str(_one_message_bag(tmp_path)), loop=True)
+        rt.add_node(player)
+        turns = 0
+        while player.statistics().loops < 200:
+            await asyncio.sleep(0)  # never returned while the player looped
+            turns += 1
+        assert turns >= 1 and not player.done
+    assert player.done  # shutdown stopped it
