@@ -42,13 +42,19 @@ def parse_remaps(remaps: list[str]) -> dict[str, str]:
 
 @dataclass(frozen=True, slots=True)
 class PlayerStatistics:
-    """What a player has done: messages published, skipped (unknown type), loops completed."""
+    """What a player has done: messages published, skipped (unknown type), loops completed.
+
+    ``subscribers``: over the topics played, the most subscriptions (local and remote) each one
+    had matched when a message was published, summed; ``topics_matched``: topics that had any.
+    """
 
     published: int
     skipped: int
     loops: int
     paused: bool
     rate: float
+    subscribers: int = 0
+    topics_matched: int = 0
 
 
 class Player(Node):
@@ -79,6 +85,7 @@ class Player(Node):
         self._published = 0
         self._skipped = 0
         self._loops = 0
+        self._matched: dict[str, int] = {}
         self.path = str(self.declare_parameter("path", path).value)
         self.rate = float(self.declare_parameter("rate", float(rate)).value)
         self.publish_clock = bool(self.declare_parameter("clock", clock).value)
@@ -126,7 +133,20 @@ class Player(Node):
         return f"<Player {self.path} rate={self.rate:g} published={self._published}>"
 
     def statistics(self) -> PlayerStatistics:
-        return PlayerStatistics(self._published, self._skipped, self._loops, not self._resume.is_set(), self.rate)
+        return PlayerStatistics(
+            self._published,
+            self._skipped,
+            self._loops,
+            not self._resume.is_set(),
+            self.rate,
+            sum(self._matched.values()),
+            sum(1 for n in self._matched.values() if n),
+        )
+
+    @property
+    def topics_played(self) -> list[str]:
+        """The bag's topics this player publishes (known types, after ``topics``), under their bag names."""
+        return list(self._topic_pubs)
 
     # -- control ------------------------------------------------------------------------
 
@@ -213,8 +233,12 @@ class Player(Node):
                             f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0
                         )
                         continue
-                    self._topic_pubs[topic].publish(msg)
+                    pub = self._topic_pubs[topic]
+                    pub.publish(msg)
                     self._published += 1
+                    matched = pub.get_subscription_count()
+                    if matched > self._matched.get(topic, 0):
+                        self._matched[topic] = matched
                 self._loops += 1
                 if not self.loop or self._published + self._skipped == played:  # nothing to play again
                     break

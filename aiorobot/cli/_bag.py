@@ -236,7 +236,16 @@ async def _play(args: argparse.Namespace) -> int:
             if keys is not None:
                 keys.close()
         stats = player.statistics()
-    print(f"played {stats.published} messages from {args.bag}" + (f" ({stats.skipped} skipped)" if stats.skipped else ""), file=sys.stderr)
+        topics = len(player.topics_played)
+    skipped = f" ({stats.skipped} skipped)" if stats.skipped else ""
+    print(
+        f"played {stats.published} messages from {args.bag}{skipped} to {stats.subscribers} subscriber(s) "
+        f"on {stats.topics_matched} of {topics} topic(s)",
+        file=sys.stderr,
+    )
+    if stats.published and not stats.subscribers:
+        where = "in this process" if args.transport == "local" else "in this process or reachable over zenoh"
+        print(f"aiorobot bag play: warning: no subscriber matched any of the {topics} topic(s) played ({where}); nothing received these messages", file=sys.stderr)
     return 0
 
 

@@ -165,6 +165,7 @@ async def test_play_starts_at_the_first_message_even_before_metadata_starting_ti
         done.set()
     assert got == [f"Hello World: {i}" for i in range(10)]
     assert stats.published == 19 and stats.skipped == 0
+    assert stats.subscribers == 1 and stats.topics_matched == 1
 
 
 def test_reindex_of_ros2_recorded_mcap_files_reads_back_every_message(tmp_path: Path) -> None:
@@ -232,3 +233,15 @@ async def test_loop_of_a_one_message_bag_leaves_the_loop_free(tmp_path: Path) ->
             turns += 1
         assert turns >= 1 and not player.done
     assert player.done  # shutdown stopped it
+
+
+def test_bag_play_reports_matched_subscribers_and_warns_in_one_line_when_none(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from aiorobot.cli import main
+
+    bag = _one_message_bag(tmp_path)
+    assert main(["bag", "play", "--transport", "local", str(bag)]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[-2:] == [
+        f"played 1 messages from {bag} to 0 subscriber(s) on 0 of 1 topic(s)",
+        "aiorobot bag play: warning: no subscriber matched any of the 1 topic(s) played (in this process); nothing received these messages",
+    ]
