@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from ._cdr import DeserializationError, SerializationError, deserialize, serialize
 from ._classgen import Action, Message, ReadOnlyMessageError, Service
-from ._describe import message_definition, type_hash
+from ._describe import message_definition, register_type_description, type_description, type_hash
 from ._registry import get, register_action, register_file, register_msg, register_srv
 
 __all__ = [
@@ -34,6 +34,8 @@ __all__ = [
     "register_file",
     "register_msg",
     "register_srv",
+    "register_type_description",
     "serialize",
+    "type_description",
     "type_hash",
 ]
