@@ -109,6 +109,12 @@ class Player(Node):
             raise BagError(f"{self.path}: no topic {missing[0]} in the bag (topics: {', '.join(sorted(known))})")
         self._topic_pubs: dict[str, Any] = {}
         self._types: dict[str, Any] = {}
+        from aiorobot.msgs.type_description_interfaces import GetTypeDescription
+
+        # As every ROS 2 Jazzy node does: another process that does not know a type played here
+        # (one registered from the bag) asks for its description, as the zenoh transport does;
+        # declared before the publishers, so it is there when they are discovered.
+        self.create_service(GetTypeDescription, "~/get_type_description", self._describe_type)
         for info in self.reader.topics:
             if self.only and info.name not in self.only:
                 continue
@@ -147,6 +153,22 @@ class Player(Node):
     def topics_played(self) -> list[str]:
         """The bag's topics this player publishes (known types, after ``topics``), under their bag names."""
         return list(self._topic_pubs)
+
+    def _describe_type(self, request: Any) -> Any:
+        """``~/get_type_description`` (type_description_interfaces/srv/GetTypeDescription) for the types played."""
+        from aiorobot.msgs import type_description, type_hash
+        from aiorobot.msgs.type_description_interfaces import GetTypeDescription
+
+        response = GetTypeDescription.Response()
+        msg_type = next((t for t in self._types.values() if t.__msgtype__ == request.type_name), None)
+        if msg_type is None:
+            response.failure_reason = f"type {request.type_name} is not played by {self.get_fully_qualified_name()}"
+        elif request.type_hash and request.type_hash != type_hash(msg_type):
+            response.failure_reason = f"type {request.type_name} is played with hash {type_hash(msg_type)}, not {request.type_hash}"
+        else:
+            response.successful = True
+            response.type_description = type_description(msg_type)
+        return response
 
     # -- control ------------------------------------------------------------------------
 
