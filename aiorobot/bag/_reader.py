@@ -59,6 +59,7 @@ class BagReader:
             self._stack.close()
             raise
         self._types: dict[str, tuple[Any, str]] = {}
+        self._start_ns: int | None = None
         self._definitions: dict[str, tuple[str, str] | None] = {}
         self.topics: list[TopicInfo] = []
         self.warnings: list[str] = []
@@ -175,15 +176,18 @@ class BagReader:
 
     @property
     def start_ns(self) -> int:
-        """The first message's time (not ``metadata.yaml``'s ``starting_time``, which may be later)."""
-        times = [int(r.start_time) for r in self._storages if r.message_count]
-        return min(times) if times else 0
+        """The first message's time: neither ``metadata.yaml``'s ``starting_time`` nor an MCAP file's
+        statistics, which can both be later (libmcap leaves a message stamped 0 out of them)."""
+        if self._start_ns is None:
+            first = next(self.messages(), None)
+            self._start_ns = first[1] if first is not None else 0
+        return self._start_ns
 
     @property
     def end_ns(self) -> int:
         """The last message's time."""
         times = [int(r.end_time) - 1 for r in self._storages if r.message_count]  # rosbags' end is exclusive
-        return max(times) if times else 0
+        return max([*times, self.start_ns]) if times else 0
 
     @property
     def duration_ns(self) -> int:

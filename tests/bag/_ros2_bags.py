@@ -64,15 +64,18 @@ class Ros2Bag:
 
 
 def ros2_bag(path: Path, storage: str, topics: list[BagTopic], *, starting_time: int | None = None,
-             metadata_only: list[tuple[str, str, int]] = ()) -> Ros2Bag:  # type: ignore[assignment]
+             metadata_only: list[tuple[str, str, int]] = (),  # type: ignore[assignment]
+             statistics_start: int | None = None) -> Ros2Bag:
     """Write the bag directory ``path`` (``storage``: ``"mcap"`` or ``"sqlite3"``) and its metadata.yaml.
 
     ``metadata_only``: ``(name, type, count)`` topics metadata.yaml lists that the storage lacks.
+    ``statistics_start``: the MCAP statistics' message_start_time, when it should not be the true
+    one (libmcap, which rosbag2 uses, leaves a message stamped 0 out of it: rosbag2's convert_a).
     """
     path.mkdir(parents=True)
     file = path / f"{path.name}_0.{'mcap' if storage == 'mcap' else 'db3'}"
     if storage == "mcap":
-        _write_mcap(file, topics)
+        _write_mcap(file, topics, statistics_start)
     else:
         _write_db3(file, topics)
     times = [t for topic in topics for t, _ in topic.messages]
@@ -122,7 +125,7 @@ def ros2_bag(path: Path, storage: str, topics: list[BagTopic], *, starting_time:
     return Ros2Bag(path, topics, start)
 
 
-def _write_mcap(file: Path, topics: list[BagTopic]) -> None:
+def _write_mcap(file: Path, topics: list[BagTopic], statistics_start: int | None = None) -> None:
     from mcap.writer import Writer
 
     with open(file, "wb") as stream:
@@ -137,6 +140,8 @@ def _write_mcap(file: Path, topics: list[BagTopic]) -> None:
         merged = sorted((t, topic.name, data) for topic in topics for t, data in topic.messages)
         for seq, (t, name, data) in enumerate(merged, 1):
             writer.add_message(channels[name], log_time=t, publish_time=t, data=data, sequence=seq)
+        if statistics_start is not None:
+            writer._Writer__statistics.message_start_time = statistics_start  # type: ignore[attr-defined]
         writer.finish()
 
 

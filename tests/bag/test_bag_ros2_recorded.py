@@ -214,6 +214,23 @@ def test_bag_info_of_a_ros2_recorded_bag_prints_seconds_from_the_integer_stamps(
     assert f"Topic: /add/_service_event | Type: bag{storage}_srvs/srv/Add_Event | Count: 4" in out
 
 
+async def test_play_starts_at_a_message_stamped_0_that_the_mcap_statistics_leave_out(tmp_path: Path) -> None:
+    """rosbag2's convert_a: a_empty's first message is stamped 0, its MCAP statistics start at 1000000."""
+    from rosbags.typesys import Stores, get_typestore
+
+    jazzy = get_typestore(Stores.ROS2_JAZZY)
+    msgs = [(t, bytes(jazzy.serialize_cdr(jazzy.types["std_msgs/msg/String"](data=str(t)), "std_msgs/msg/String")))
+            for t in (0, 1_000_000, 2_000_000)]
+    bag = ros2_bag(tmp_path / "zero", "mcap", [BagTopic("/z", "std_msgs/msg/String", "string data\n", msgs)],
+                   starting_time=0, statistics_start=1_000_000)
+    async with Runtime(handle_signals=False) as rt:
+        player = Player(path=str(bag.path), rate=100.0)
+        rt.add_node(player)
+        assert player.reader.start_ns == 0
+        assert await player.wait_for_completion(30)
+    assert player.statistics().published == 3
+
+
 def _one_message_bag(tmp_path: Path) -> Path:
     from rosbags.typesys import Stores, get_typestore
 
