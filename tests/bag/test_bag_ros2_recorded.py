@@ -262,3 +262,24 @@ def test_bag_play_reports_matched_subscribers_and_warns_in_one_line_when_none(tm
         f"played 1 messages from {bag} to 0 subscriber(s) on 0 of 1 topic(s)",
         "aiorobot bag play: warning: no subscriber matched any of the 1 topic(s) played (in this process); nothing received these messages",
     ]
+
+
+@pytest.mark.parametrize("mode", ["file", "message"])
+def test_zstd_compressed_bags_read_every_message(tmp_path: Path, mode: str) -> None:
+    """ros2 bag record --compression-mode file|message --compression-format zstd (written here by rosbags)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+    from rosbags.typesys import Stores, get_typestore
+
+    jazzy = get_typestore(Stores.ROS2_JAZZY)
+    bag = tmp_path / f"zstd_{mode}"
+    writer = Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode[mode.upper()], CompressionFormat.ZSTD)
+    with writer:
+        conn = writer.add_connection("/chatter", "std_msgs/msg/String", typestore=jazzy)
+        for i in range(5):
+            writer.write(conn, T0 + i, bytes(jazzy.serialize_cdr(jazzy.types["std_msgs/msg/String"](data=f"m{i}"), "std_msgs/msg/String")))
+    with BagReader(bag) as reader:
+        got = [deserialize(data, reader.message_type(topic)).data for topic, _, data in reader.messages()]
+        assert reader.warnings == [] and reader.start_ns == T0
+    assert got == [f"m{i}" for i in range(5)]
