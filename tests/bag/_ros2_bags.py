@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["BagTopic", "Ros2Bag", "ros2_bag", "qos_text"]
+__all__ = ["BagTopic", "Ros2Bag", "qos_text", "ros2_bag", "stored_counts", "typestore", "write_mcap"]
 
 
 def qos_text(deadline_sec: int, deadline_nsec: int, *, indent: str = "") -> str:
@@ -75,7 +75,7 @@ def ros2_bag(path: Path, storage: str, topics: list[BagTopic], *, starting_time:
     path.mkdir(parents=True)
     file = path / f"{path.name}_0.{'mcap' if storage == 'mcap' else 'db3'}"
     if storage == "mcap":
-        _write_mcap(file, topics, statistics_start)
+        write_mcap(file, topics, statistics_start)
     else:
         _write_db3(file, topics)
     times = [t for topic in topics for t, _ in topic.messages]
@@ -125,7 +125,7 @@ def ros2_bag(path: Path, storage: str, topics: list[BagTopic], *, starting_time:
     return Ros2Bag(path, topics, start)
 
 
-def _write_mcap(file: Path, topics: list[BagTopic], statistics_start: int | None = None) -> None:
+def write_mcap(file: Path, topics: list[BagTopic], statistics_start: int | None = None) -> None:
     from mcap.writer import Writer
 
     with open(file, "wb") as stream:

@@ -18,7 +18,7 @@ from aiorobot import Node, QoSProfile, Runtime
 from aiorobot.bag import BagReader, Player
 from aiorobot.msgs import deserialize
 
-from ._ros2_bags import METADATA_QOS_ARGS, STORAGE_QOS, BagTopic, Ros2Bag, qos_text, ros2_bag, stored_counts, typestore
+from ._ros2_bags import METADATA_QOS_ARGS, STORAGE_QOS, BagTopic, Ros2Bag, qos_text, ros2_bag, stored_counts, typestore, write_mcap
 
 T0 = 1_586_406_456_763_032_325  # cdr_test's first stamp: the float of it in seconds is not exact
 
@@ -170,7 +170,9 @@ async def test_play_starts_at_the_first_message_even_before_metadata_starting_ti
 
 def test_reindex_of_ros2_recorded_mcap_files_reads_back_every_message(tmp_path: Path) -> None:
     """rosbag2's reindex_test_bags/multiple_files: three whole MCAP files and no metadata.yaml."""
+    from rosbags.highlevel import AnyReader
     from rosbags.rosbag2 import Reader
+    from rosbags.typesys import Stores, get_typestore
 
     from aiorobot.bag import reindex
 
@@ -183,9 +185,7 @@ def test_reindex_of_ros2_recorded_mcap_files_reads_back_every_message(tmp_path: 
         parts.append(part)
     bag.mkdir()
     for i, part in enumerate(parts):  # rewrite each part's messages into multiple_files_<i>.mcap, no metadata.yaml
-        from ._ros2_bags import _write_mcap
-
-        _write_mcap(bag / f"multiple_files_{i}.mcap", part.topics)
+        write_mcap(bag / f"multiple_files_{i}.mcap", part.topics)
     before = {p.name: p.read_bytes() for p in bag.iterdir()}
     total = sum(len(t.messages) for part in parts for t in part.topics)
     result = reindex(bag)
@@ -193,6 +193,15 @@ def test_reindex_of_ros2_recorded_mcap_files_reads_back_every_message(tmp_path: 
     assert {p.name: p.read_bytes() for p in bag.iterdir() if p.suffix == ".mcap"} == before  # whole files are left alone
     with Reader(bag) as reader:  # rosbags' rosbag2 reader pairs metadata.yaml's QoS with the channels' by equality
         assert sum(1 for _ in reader.messages()) == total
+    plain = tmp_path / "plain"  # AnyReader parses every definition (not a .srv text): the String topic alone
+    plain.mkdir()
+    for i, part in enumerate(parts):
+        write_mcap(plain / f"plain_{i}.mcap", [t for t in part.topics if t.name == "/topic"])
+    assert reindex(plain).messages == 12
+    with AnyReader([plain], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as reader:
+        assert [reader.deserialize(raw, c.msgtype).data for c, _, raw in reader.messages()] == [
+            f"Hello World: {i}" for n in (5, 5, 2) for i in range(n)
+        ]
     with BagReader(bag) as reader:
         assert reader.warnings == []
         assert sum(1 for _ in reader.messages()) == total
