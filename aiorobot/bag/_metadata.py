@@ -29,6 +29,10 @@ class TopicInfo:
     qos: QoSProfile
     message_count: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
+    #: ``offered_qos_profiles`` as the storage file holds it (YAML text); when set, ``metadata.yaml``
+    #: gets these profiles, every field kept, so readers that pair the two by equality (rosbags)
+    #: find the topic.
+    qos_text: str = ""
 
 
 def qos_to_bag(qos: QoSProfile) -> Any:
@@ -97,7 +101,7 @@ def write_metadata(
 
     ``files``: one dict per storage file, ``{"path", "start_ns", "duration_ns", "message_count"}``.
     """
-    from rosbags.rosbag2.metadata import dump_qos_v9
+    from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 
     start = min((f["start_ns"] for f in files if f["message_count"]), default=0)
     end = max((f["start_ns"] + f["duration_ns"] for f in files if f["message_count"]), default=start)
@@ -115,7 +119,7 @@ def write_metadata(
                         "name": t.name,
                         "type": t.type,
                         "serialization_format": "cdr",
-                        "offered_qos_profiles": dump_qos_v9([qos_to_bag(t.qos)]),
+                        "offered_qos_profiles": dump_qos_v9(parse_qos(t.qos_text) if t.qos_text else [qos_to_bag(t.qos)]),
                         "type_description_hash": t.type_hash,
                     },
                     "message_count": t.message_count,

@@ -1,9 +1,14 @@
 """``Player``: plays a rosbag2 directory back into a graph, paced like the recording.
 
-Messages are published in time order with the recorded spacing divided by ``rate``. With
-``clock`` the player also publishes ``/clock`` (rosgraph_msgs/Clock) carrying the playback
-time, at ``clock_hz`` between messages and exactly at each message's recorded time just
-before it is published, so nodes on sim time see ``now()`` equal to the recorded stamp.
+Messages are published in time order with the recorded spacing divided by ``rate``, from the
+first message on (``metadata.yaml``'s ``starting_time`` may be later than it). With ``clock``
+the player also publishes ``/clock`` (rosgraph_msgs/Clock) carrying the playback time, at
+``clock_hz`` between messages and exactly at each message's recorded time just before it is
+published, so nodes on sim time see ``now()`` equal to the recorded stamp.
+
+The player shares the loop: it never holds it longer than ``_YIELD_NS`` while catching up on
+messages that are due, and a ``loop`` pass of a bag whose messages all share one stamp still
+gives the loop a turn, so a very short bag played with ``loop`` cannot starve it.
 """
 
 from __future__ import annotations
@@ -20,6 +25,9 @@ from ._reader import BagReader
 
 __all__ = ["Player", "PlayerStatistics", "parse_remaps"]
 
+#: The longest the player publishes due messages back to back before giving the loop a turn.
+_YIELD_NS = 2_000_000
+
 
 def parse_remaps(remaps: list[str]) -> dict[str, str]:
     """``["/a:=/b", ...]`` -> ``{"/a": "/b"}``; a malformed entry raises ValueError naming it."""
@@ -34,13 +42,19 @@ def parse_remaps(remaps: list[str]) -> dict[str, str]:
 
 @dataclass(frozen=True, slots=True)
 class PlayerStatistics:
-    """What a player has done: messages published, skipped (unknown type), loops completed."""
+    """What a player has done: messages published, skipped (unknown type), loops completed.
+
+    ``subscribers``: over the topics played, the most subscriptions (local and remote) each one
+    had matched when a message was published, summed; ``topics_matched``: topics that had any.
+    """
 
     published: int
     skipped: int
     loops: int
     paused: bool
     rate: float
+    subscribers: int = 0
+    topics_matched: int = 0
 
 
 class Player(Node):
@@ -71,6 +85,7 @@ class Player(Node):
         self._published = 0
         self._skipped = 0
         self._loops = 0
+        self._matched: dict[str, int] = {}
         self.path = str(self.declare_parameter("path", path).value)
         self.rate = float(self.declare_parameter("rate", float(rate)).value)
         self.publish_clock = bool(self.declare_parameter("clock", clock).value)
@@ -94,12 +109,18 @@ class Player(Node):
             raise BagError(f"{self.path}: no topic {missing[0]} in the bag (topics: {', '.join(sorted(known))})")
         self._topic_pubs: dict[str, Any] = {}
         self._types: dict[str, Any] = {}
+        from aiorobot.msgs.type_description_interfaces import GetTypeDescription
+
+        # As every ROS 2 Jazzy node does: another process that does not know a type played here
+        # (one registered from the bag) asks for its description, as the zenoh transport does;
+        # declared before the publishers, so it is there when they are discovered.
+        self.create_service(GetTypeDescription, "~/get_type_description", self._describe_type)
         for info in self.reader.topics:
             if self.only and info.name not in self.only:
                 continue
             msg_type = self.reader.message_type(info.name)
             if msg_type is None:
-                self.get_logger().warning(f"{info.name}: type {info.type} is unknown; its {info.message_count} messages are skipped")
+                self.get_logger().warning(f"{info.name}: {self.reader.type_problem(info.name)}; its {info.message_count} messages are skipped")
                 continue
             self._types[info.name] = msg_type
             self._topic_pubs[info.name] = self.create_publisher(msg_type, self.remaps.get(info.name, info.name), info.qos)
@@ -118,7 +139,36 @@ class Player(Node):
         return f"<Player {self.path} rate={self.rate:g} published={self._published}>"
 
     def statistics(self) -> PlayerStatistics:
-        return PlayerStatistics(self._published, self._skipped, self._loops, not self._resume.is_set(), self.rate)
+        return PlayerStatistics(
+            self._published,
+            self._skipped,
+            self._loops,
+            not self._resume.is_set(),
+            self.rate,
+            sum(self._matched.values()),
+            sum(1 for n in self._matched.values() if n),
+        )
+
+    @property
+    def topics_played(self) -> list[str]:
+        """The bag's topics this player publishes (known types, after ``topics``), under their bag names."""
+        return list(self._topic_pubs)
+
+    def _describe_type(self, request: Any) -> Any:
+        """``~/get_type_description`` (type_description_interfaces/srv/GetTypeDescription) for the types played."""
+        from aiorobot.msgs import type_description, type_hash
+        from aiorobot.msgs.type_description_interfaces import GetTypeDescription
+
+        response = GetTypeDescription.Response()
+        msg_type = next((t for t in self._types.values() if t.__msgtype__ == request.type_name), None)
+        if msg_type is None:
+            response.failure_reason = f"type {request.type_name} is not played by {self.get_fully_qualified_name()}"
+        elif request.type_hash and request.type_hash != type_hash(msg_type):
+            response.failure_reason = f"type {request.type_name} is played with hash {type_hash(msg_type)}, not {request.type_hash}"
+        else:
+            response.successful = True
+            response.type_description = type_description(msg_type)
+        return response
 
     # -- control ------------------------------------------------------------------------
 
@@ -168,10 +218,12 @@ class Player(Node):
 
         start = self.reader.start_ns + int(self.start_offset * 1e9)
         clock_period_ns = int(1e9 / self.clock_hz)
+        turn = time.monotonic_ns()  # when the loop last had a turn
         try:
             while True:
                 wall_t0 = time.monotonic_ns()
                 last_clock = wall_t0 - clock_period_ns
+                played = self._published + self._skipped
                 for topic, t_ns, data in self.reader.messages(list(self._types), start_ns=start):
                     while True:  # pace: wait for the message's time, publishing /clock meanwhile
                         if not self._resume.is_set():
@@ -181,6 +233,9 @@ class Player(Node):
                         now = time.monotonic_ns()
                         due = wall_t0 + int((t_ns - start) / self.rate)
                         if now >= due:
+                            if now - turn >= _YIELD_NS:  # behind schedule: still let the loop run
+                                await asyncio.sleep(0)
+                                turn = time.monotonic_ns()
                             break
                         wake = due
                         if self._clock_pub is not None:
@@ -189,6 +244,7 @@ class Player(Node):
                                 last_clock = now
                             wake = min(due, last_clock + clock_period_ns)
                         await self._sleep_until_ns(wake)
+                        turn = time.monotonic_ns()
                     if self._clock_pub is not None:
                         self._publish_clock(t_ns)
                     try:
@@ -199,11 +255,17 @@ class Player(Node):
                             f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0
                         )
                         continue
-                    self._topic_pubs[topic].publish(msg)
+                    pub = self._topic_pubs[topic]
+                    pub.publish(msg)
                     self._published += 1
+                    matched = pub.get_subscription_count()
+                    if matched > self._matched.get(topic, 0):
+                        self._matched[topic] = matched
                 self._loops += 1
-                if not self.loop:
+                if not self.loop or self._published + self._skipped == played:  # nothing to play again
                     break
+                await asyncio.sleep(0)  # a pass may have taken no time at all: the loop gets a turn
+                turn = time.monotonic_ns()
         finally:
             self._done.set()
 

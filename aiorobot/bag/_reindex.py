@@ -2,8 +2,9 @@
 
 An MCAP file written chunk by chunk and never finished has no summary, no footer and maybe a
 torn last chunk. Reading it as a stream recovers every record up to the last complete one;
-the messages are written again into a finished file (which replaces the damaged one) and
-``metadata.yaml`` is written from what was recovered.
+the messages are written again into a finished file (which replaces the damaged one; a file
+that is whole is left as it is, as ``ros2 bag reindex`` does) and ``metadata.yaml`` is written
+from what was recovered, each topic with the QoS profiles its channel holds, every field kept.
 """
 
 from __future__ import annotations
@@ -13,8 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from ._metadata import BagError, TopicInfo, write_metadata
+from .._qos import QoSProfile
+from ._metadata import BagError, TopicInfo, qos_from_bag, write_metadata
 from ._writer import CHUNK_SIZE
 
 __all__ = ["ReindexResult", "reindex"]
@@ -57,14 +58,14 @@ def _file_index(p: Path) -> tuple[int, str]:
 
 def _rewrite(mcap_path: Path, topics: dict[str, TopicInfo]) -> tuple[dict[str, Any], int]:
     from mcap.exceptions import McapError
-    from mcap.records import Channel, Message, Schema
+    from mcap.records import Channel, Footer, Message, Schema
     from mcap.stream_reader import StreamReader
-    from mcap.writer import CompressionType, Writer
 
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
     messages: list[Message] = []
     broken = 0
+    finished = False
     with open(mcap_path, "rb") as stream:
         try:
             for record in StreamReader(stream, skip_magic=False).records:
@@ -74,12 +75,53 @@ def _rewrite(mcap_path: Path, topics: dict[str, TopicInfo]) -> tuple[dict[str, A
                     channels[record.id] = record
                 elif isinstance(record, Message):
                     messages.append(record)
+                elif isinstance(record, Footer):
+                    finished = True
         except (McapError, EOFError, ValueError, OSError) as err:  # torn tail: keep what came before
             broken = 1
             _log.info("%s: stopped at a damaged or unfinished record (%s); %d messages recovered", mcap_path, err, len(messages))
         except Exception as err:  # the decompressor's own errors on a torn chunk
             broken = 1
             _log.info("%s: stopped at a damaged chunk (%s); %d messages recovered", mcap_path, err, len(messages))
+    if not broken and not finished:
+        broken = 1
+        _log.info("%s: ends without a footer (the recording did not finish); %d messages recovered", mcap_path, len(messages))
+    if broken:  # an undamaged file stays as it is (ros2 bag reindex writes only metadata.yaml)
+        _write_finished(mcap_path, schemas, channels, messages)
+    counts: dict[int, int] = {}
+    for m in messages:
+        counts[m.channel_id] = counts.get(m.channel_id, 0) + 1
+    for cid, c in channels.items():
+        schema = schemas.get(c.schema_id)
+        info = topics.get(c.topic)
+        if info is None:
+            from aiorobot.msgs import type_hash
+
+            type_name = schema.name if schema is not None else ""
+            digest = c.metadata.get("topic_type_hash", "")
+            if not digest:
+                try:
+                    digest = type_hash(type_name)
+                except Exception:
+                    digest = ""
+            qos_text = c.metadata.get("offered_qos_profiles", "")
+            qos, readable = _qos_from_text(qos_text, mcap_path, c.topic)
+            info = topics[c.topic] = TopicInfo(c.topic, type_name, digest, qos, qos_text=qos_text if readable else "")
+        info.message_count += counts.get(cid, 0)
+    times = [m.log_time for m in messages]
+    start = min(times, default=0)
+    return {
+        "path": mcap_path.name,
+        "start_ns": start,
+        "duration_ns": max(times, default=start) - start,
+        "message_count": len(messages),
+    }, broken
+
+
+def _write_finished(mcap_path: Path, schemas: dict[int, Any], channels: dict[int, Any], messages: list[Any]) -> None:
+    """Write the recovered records into a finished MCAP file that replaces ``mcap_path``."""
+    from mcap.writer import CompressionType, Writer
+
     tmp = mcap_path.with_suffix(".mcap.reindex")
     with open(tmp, "wb") as out:
         writer = Writer(out, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
@@ -94,46 +136,16 @@ def _rewrite(mcap_path: Path, topics: dict[str, TopicInfo]) -> tuple[dict[str, A
                 writer.add_message(channel_ids[m.channel_id], log_time=m.log_time, data=m.data, publish_time=m.publish_time, sequence=m.sequence)
         writer.finish()
     tmp.replace(mcap_path)
-    counts: dict[int, int] = {}
-    for m in messages:
-        counts[m.channel_id] = counts.get(m.channel_id, 0) + 1
-    for cid, c in channels.items():
-        schema = schemas.get(c.schema_id)
-        info = topics.get(c.topic)
-        if info is None:
-            from aiorobot.msgs import type_hash
-
-            type_name = schema.name if schema is not None else ""
-            try:
-                digest = type_hash(type_name)
-            except Exception:
-                digest = ""
-            info = topics[c.topic] = TopicInfo(c.topic, type_name, digest, _qos_from_yaml(c.metadata.get("offered_qos_profiles", "")))
-        info.message_count += counts.get(cid, 0)
-    times = [m.log_time for m in messages]
-    start = min(times, default=0)
-    return {
-        "path": mcap_path.name,
-        "start_ns": start,
-        "duration_ns": max(times, default=start) - start,
-        "message_count": len(messages),
-    }, broken
 
 
-def _qos_from_yaml(text: str) -> QoSProfile:
-    """The first profile of an ``offered_qos_profiles`` YAML text; the default when absent or unreadable."""
-    from ruamel.yaml import YAML
+def _qos_from_text(text: str, where: Path, topic: str) -> tuple[QoSProfile, bool]:
+    """The replay QoS of a channel's ``offered_qos_profiles`` text, and whether the text could be read."""
+    from rosbags.rosbag2.metadata import parse_qos
 
+    if not text:
+        return QoSProfile(), False
     try:
-        profiles = YAML(typ="safe").load(text) if text else None
-        p = profiles[0] if profiles else None
-    except Exception:
-        p = None
-    if not isinstance(p, dict):
-        return QoSProfile()
-    return QoSProfile(
-        reliability=ReliabilityPolicy.BEST_EFFORT if p.get("reliability") == "best_effort" else ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL if p.get("durability") == "transient_local" else DurabilityPolicy.VOLATILE,
-        history=HistoryPolicy.KEEP_ALL if p.get("history") == "keep_all" else HistoryPolicy.KEEP_LAST,
-        depth=max(1, int(p.get("depth") or 10)),
-    )
+        return qos_from_bag(parse_qos(text)), True
+    except Exception as err:  # noqa: BLE001 - a damaged channel record: replay with the default QoS
+        _log.warning("%s: topic %s: offered_qos_profiles cannot be read (%s); the default QoS is used", where, topic, err)
+        return QoSProfile(), False

@@ -117,9 +117,14 @@ def _size(n: float) -> str:
     return f"{n:.1f} GiB"
 
 
+def _seconds(ns: int) -> str:
+    """``ns`` as seconds with nine decimals, from the integer (a float loses the last digits)."""
+    return f"{'-' if ns < 0 else ''}{abs(ns) // 1_000_000_000}.{abs(ns) % 1_000_000_000:09d}"
+
+
 def _stamp(ns: int) -> str:
-    t = datetime.datetime.fromtimestamp(ns / 1e9, datetime.timezone.utc)
-    return f"{t:%b %d %Y %H:%M:%S}.{ns % 1_000_000_000:09d} ({ns / 1e9:.9f})"
+    t = datetime.datetime.fromtimestamp(ns // 1_000_000_000, datetime.timezone.utc)
+    return f"{t:%b %d %Y %H:%M:%S}.{ns % 1_000_000_000:09d} ({_seconds(ns)})"
 
 
 def info_text(path: Path) -> str:
@@ -133,7 +138,7 @@ def info_text(path: Path) -> str:
             *(f"                   {f.name}" for f in files[1:]),
             f"Bag size:          {_size(sum(f.stat().st_size for f in files if f.exists()))}",
             f"Storage id:        {reader.storage}",
-            f"Duration:          {reader.duration_ns / 1e9:.9f}s",
+            f"Duration:          {_seconds(reader.duration_ns)}s",
             f"Start:             {_stamp(reader.start_ns)}",
             f"End:               {_stamp(reader.end_ns)}",
             f"Messages:          {reader.message_count}",
@@ -231,7 +236,16 @@ async def _play(args: argparse.Namespace) -> int:
             if keys is not None:
                 keys.close()
         stats = player.statistics()
-    print(f"played {stats.published} messages from {args.bag}" + (f" ({stats.skipped} skipped)" if stats.skipped else ""), file=sys.stderr)
+        topics = len(player.topics_played)
+    skipped = f" ({stats.skipped} skipped)" if stats.skipped else ""
+    print(
+        f"played {stats.published} messages from {args.bag}{skipped} to {stats.subscribers} subscriber(s) "
+        f"on {stats.topics_matched} of {topics} topic(s)",
+        file=sys.stderr,
+    )
+    if stats.published and not stats.subscribers:
+        where = "in this process" if args.transport == "local" else "in this process or reachable over zenoh"
+        print(f"aiorobot bag play: warning: no subscriber matched any of the {topics} topic(s) played ({where}); nothing received these messages", file=sys.stderr)
     return 0
 
 

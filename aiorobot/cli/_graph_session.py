@@ -91,8 +91,8 @@ async def settle_discovery(transport: Any) -> None:
         now_seen = len(transport._remote)
         if now_seen != seen:
             seen, last_change = now_seen, time.monotonic()
-        elif time.monotonic() - last_change >= QUIET_SEC:
-            return
+        elif time.monotonic() - last_change >= QUIET_SEC and not getattr(transport, "_describing", None):
+            return  # quiet, and no remote node is still describing a type this process did not know
 
 
 def remote_node_names(rt: Any) -> list[str]:

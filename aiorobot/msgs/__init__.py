@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from ._cdr import DeserializationError, SerializationError, deserialize, serialize
 from ._classgen import Action, Message, ReadOnlyMessageError, Service
-from ._describe import message_definition, type_hash
+from ._describe import message_definition, register_type_description, type_description, type_hash
 from ._registry import get, register_action, register_file, register_msg, register_srv
 from ._ros_packages import register_from_env, register_package
 
@@ -42,6 +42,8 @@ __all__ = [
     "register_msg",
     "register_package",
     "register_srv",
+    "register_type_description",
     "serialize",
+    "type_description",
     "type_hash",
 ]

@@ -1,4 +1,9 @@
-"""Type hashes (REP-2011 RIHS01) and message definition texts (for MCAP schemas)."""
+"""Type hashes (REP-2011 RIHS01), type descriptions and message definition texts (for MCAP schemas).
+
+``type_description`` gives the ``type_description_interfaces/msg/TypeDescription`` a ROS 2 Jazzy
+node's ``~/get_type_description`` service answers with (the structure the type hash is computed
+over); ``register_type_description`` registers a type this process does not know from one.
+"""
 
 from __future__ import annotations
 
@@ -7,7 +12,7 @@ from typing import Any
 from ._registry import ActionSpec, ServiceSpec, get_spec
 from ._spec import ARRAY, SCALAR, FieldType, MsgSpec
 
-__all__ = ["message_definition", "type_hash"]
+__all__ = ["message_definition", "register_type_description", "type_description", "type_hash"]
 
 # type_description_interfaces/msg/FieldType ids. A .msg ``char`` is IDL ``uint8`` in
 # rosidl (rosidl_adapter MSG_TYPE_TO_IDL), so it hashes as UINT8, not CHAR.
@@ -70,12 +75,8 @@ def _struct_fields(spec: Any) -> list[tuple[str, FieldType]]:
             ("feedback_message", _nested(spec.feedback_message.name))]
 
 
-def type_hash(msg_type: type | str) -> str:
-    """REP-2011 type hash ``RIHS01_<sha256 hex>`` of a message, service or action type.
-
-    Equal to what ROS 2 Jazzy computes (rosidl_generator_type_description), so it can
-    be used in rmw_zenoh key expressions and bag metadata.
-    """
+def _description(msg_type: type | str) -> dict[str, Any]:
+    """The type description of REP-2011 as plain data: the type and every type it references (sorted)."""
     top = get_spec(_name_of(msg_type))
     structs: dict[str, dict[str, Any]] = {}
 
@@ -89,16 +90,96 @@ def type_hash(msg_type: type | str) -> str:
             if t.is_message:
                 visit(get_spec(t.base))
 
-    import hashlib
-    import json
-
     visit(top)
-    doc = {
+    return {
         "type_description": structs[top.name],
         "referenced_type_descriptions": [structs[k] for k in sorted(structs) if k != top.name],
     }
-    digest = hashlib.sha256(json.dumps(doc).encode()).hexdigest()
+
+
+def type_hash(msg_type: type | str) -> str:
+    """REP-2011 type hash ``RIHS01_<sha256 hex>`` of a message, service or action type.
+
+    Equal to what ROS 2 Jazzy computes (rosidl_generator_type_description), so it can
+    be used in rmw_zenoh key expressions and bag metadata.
+    """
+    import hashlib
+    import json
+
+    digest = hashlib.sha256(json.dumps(_description(msg_type)).encode()).hexdigest()
     return f"RIHS01_{digest}"
+
+
+def type_description(msg_type: type | str) -> Any:
+    """``msg_type``'s ``type_description_interfaces/msg/TypeDescription`` (fields without default values)."""
+    from .type_description_interfaces import Field, FieldType, IndividualTypeDescription, TypeDescription
+
+    def individual(d: dict[str, Any]) -> Any:
+        return IndividualTypeDescription(
+            type_name=d["type_name"],
+            fields=[Field(name=f["name"], type=FieldType(**f["type"])) for f in d["fields"]],
+        )
+
+    doc = _description(msg_type)
+    return TypeDescription(
+        type_description=individual(doc["type_description"]),
+        referenced_type_descriptions=[individual(d) for d in doc["referenced_type_descriptions"]],
+    )
+
+
+_BASE_TEXT = {v: k for k, v in _TYPE_IDS.items() if k != "char"}
+
+
+def _field_text(field: Any) -> str:
+    """A TypeDescription field as a .msg line."""
+    tid, capacity, bound = int(field.type.type_id), int(field.type.capacity), int(field.type.string_capacity)
+    kind, base_id = divmod(tid - 1, 48)
+    base_id += 1
+    if base_id == _NESTED:
+        base = field.type.nested_type_name
+    elif base_id in (21, 22):
+        base = f"{'string' if base_id == 21 else 'wstring'}<={bound}"
+    elif base_id in _BASE_TEXT:
+        base = _BASE_TEXT[base_id]
+    else:
+        raise ValueError(f"field {field.name!r}: type id {tid} has no .msg spelling")
+    suffix = ("", f"[{capacity}]", f"[<={capacity}]", "[]")[kind] if kind < 4 else None
+    if suffix is None:
+        raise ValueError(f"field {field.name!r}: unknown type id {tid}")
+    return f"{base}{suffix} {field.name}"
+
+
+def register_type_description(description: Any) -> type:
+    """Register the type ``description`` (a TypeDescription) describes, and the types it references
+    that this process does not know; returns its class. A service's ``X_Event`` (a service-event
+    topic) registers the service ``X``. Raises ValueError when a description cannot be used."""
+    from ._registry import exists, get, register_msg, register_srv
+
+    texts = {d.type_name: "".join(_field_text(f) + "\n" for f in d.fields if f.name != "structure_needs_at_least_one_member")
+             for d in [description.type_description, *description.referenced_type_descriptions]}
+    top = description.type_description.type_name
+    services = {}
+    for name in texts:
+        pkg, kind, short = name.split("/")
+        if kind == "srv" and short.endswith("_Event") and not exists(name):
+            base = f"{pkg}/srv/{short[: -len('_Event')]}"
+            services[base] = f"{texts[f'{base}_Request']}---\n{texts[f'{base}_Response']}"
+    pending = {n: t for n, t in texts.items() if n.split("/")[1] == "msg" and not exists(n)}
+    while pending:  # dependencies first: register what can be, until nothing is left
+        done = []
+        for name, text in pending.items():
+            try:
+                register_msg(text, name)
+            except LookupError:
+                continue
+            done.append(name)
+        if not done:
+            raise ValueError(f"cannot register {', '.join(sorted(pending))}: they refer to types that are not described")
+        for name in done:
+            del pending[name]
+    for name, text in services.items():
+        register_srv(text, name)
+    return get(top)
 
 
 def _short(name: str) -> str:

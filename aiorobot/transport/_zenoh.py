@@ -75,6 +75,8 @@ DEFAULT_LISTEN = "tcp/127.0.0.1:0"
 #: A service query waits this long at most on the zenoh side (callers time out on their own).
 QUERY_TIMEOUT_SEC = 24 * 3600.0
 WARN_INTERVAL_SEC = 1.0
+#: How long a remote node has to describe a type this process does not know (``~/get_type_description``).
+DESCRIBE_TIMEOUT_SEC = 5.0
 #: rmw_zenoh's defaults: a 48 MiB shared-memory pool per session, used for messages of 2 KiB and more
 #: (``ZENOH_SHM_ALLOC_SIZE`` and ``ZENOH_SHM_MESSAGE_SIZE_THRESHOLD`` change them, in bytes)
 SHM_ALLOC_SIZE = 48 * 1024 * 1024
@@ -437,6 +439,11 @@ class ZenohTransport(Transport):
         self._inbound: dict[tuple[str, str], _Inbound] = {}
         self._queryables: dict[int, Any] = {}
         self._remote: dict[str, Any] = {}  # token -> what it added to the bus
+        self._describing: dict[str, Any] = {}  # token -> its TokenInfo, while its type's description is asked for
+        self._descriptions: dict[tuple[str, str], str] = {}  # (type, hash) -> "asked" | "known" | "failed" | "unanswered"
+        self._undescribed: dict[str, list[Any]] = {}  # node -> TokenInfos asked again once it serves get_type_description
+        self._describers: set[str] = set()  # nodes whose get_type_description service was seen
+        self._asks: Counter[tuple[str, str]] = Counter()  # queries sent per (type, hash)
         self._remote_nodes: dict[str, NodeInfo] = {}
         self._by_gid: dict[bytes, _Injector] = {}
         self._liveliness_sub: Any = None
@@ -881,7 +888,7 @@ class ZenohTransport(Transport):
             if not alive:
                 self._forget(token)
                 return
-            if token in self._remote:
+            if token in self._remote or token in self._describing:
                 return
             try:
                 self._learn(info)
@@ -901,6 +908,8 @@ class ZenohTransport(Transport):
         try:
             cls = get(info.type_name)
         except Exception:
+            if info.kind == "MP" and self._ask_description(info):
+                return  # learnt again once the publisher's node has described the type
             self._remote[info.token] = None  # a type this process does not know: nothing to deliver
             return
         local_hash = self._hash(cls)
@@ -922,6 +931,9 @@ class ZenohTransport(Transport):
             self._remote[info.token] = tap
             self._add_to_bus(tap)
         elif info.kind == "SS":
+            if info.topic == f"{info.node_fqn.rstrip('/')}/get_type_description":
+                self._describers.add(info.node_fqn)
+                self._describe_again(info.node_fqn)
             key = data_key(self.domain_id, info.topic, info.type_name, info.type_hash)
             server = _RemoteServer(self, cls, info.topic, key, info.node_fqn)
             self._remote[info.token] = server
@@ -930,6 +942,94 @@ class ZenohTransport(Transport):
             client = _RemoteClient(info.type_name, info.topic, info.node_fqn)
             self._remote[info.token] = client
             bus.services.add(client)  # type: ignore[arg-type]
+
+    def _ask_description(self, info: Any) -> bool:
+        """Ask the publishing node's ``~/get_type_description`` (every ROS 2 Jazzy node serves it, and
+        aiorobot's bag player) for a type this process does not know. True while an answer is awaited."""
+        import zenoh
+
+        from ..msgs import serialize
+        from ..msgs.type_description_interfaces import GetTypeDescription
+
+        key = (info.type_name, info.type_hash)
+        state = self._descriptions.get(key)
+        if state in ("known", "failed"):
+            return False
+        if state == "unanswered":  # the node's service was not there yet: wait for its token
+            self._undescribed.setdefault(info.node_fqn, []).append(info)
+            return False
+        self._describing[info.token] = info
+        if state == "asked":
+            return True
+        self._descriptions[key] = "asked"
+        self._asks[key] += 1
+        answered = {"done": False}
+
+        def on_reply(reply: Any) -> None:
+            if answered["done"] or reply.ok is None:
+                return
+            answered["done"] = True
+            self._to_loop(self._on_description, key, info.node_fqn, reply.ok.payload.to_bytes())
+
+        def on_done() -> None:
+            if not answered["done"]:
+                self._to_loop(self._on_description, key, info.node_fqn, None)
+
+        srv_key = data_key(self.domain_id, f"{info.node_fqn}/get_type_description", GetTypeDescription.__msgtype__,
+                           self._hash(GetTypeDescription))
+        request = GetTypeDescription.Request(type_name=info.type_name, type_hash=info.type_hash, include_type_sources=False)
+        self._session.get(
+            srv_key,
+            zenoh.handlers.Callback(on_reply, on_done),
+            target=zenoh.QueryTarget.ALL_COMPLETE,
+            payload=serialize(request),
+            attachment=pack_attachment(next(self._ids), time.time_ns(), self._client_gid),
+            timeout=DESCRIBE_TIMEOUT_SEC,
+        )
+        return True
+
+    def _on_description(self, key: tuple[str, str], node: str, payload: bytes | None) -> None:
+        """On the main loop: register the described type, then learn the endpoints that waited for it."""
+        from ..msgs import deserialize, register_type_description
+        from ..msgs.type_description_interfaces import GetTypeDescription
+
+        ok = False
+        if payload is not None:
+            try:
+                response = deserialize(payload, GetTypeDescription.Response)
+                if not response.successful:
+                    raise ValueError(response.failure_reason or "no reason given")
+                register_type_description(response.type_description)
+                ok = True
+            except Exception as err:  # noqa: BLE001 - a bad answer leaves the type unknown, as before
+                _log.warning(f"{node} described type {key[0]}, but it cannot be used: {err}")
+        self._descriptions[key] = "known" if ok else "failed" if payload is not None else "unanswered"
+        if self.bus is None:
+            return
+        with self._lock:
+            for token, info in list(self._describing.items()):
+                if (info.type_name, info.type_hash) != key:
+                    continue
+                del self._describing[token]
+                self._remote[token] = None
+                if payload is None:  # no get_type_description at that node (yet): ask when it appears
+                    self._undescribed.setdefault(info.node_fqn, []).append(info)
+                    if info.node_fqn in self._describers and self._asks[key] < 3:
+                        self._describe_again(info.node_fqn)  # it appeared while the query was on its way
+                elif ok:
+                    try:
+                        self._learn(info)
+                    except Exception as err:  # noqa: BLE001 - a bad peer must not break discovery
+                        self._warn("token", f"could not add remote {info.kind} {info.topic}: {err}")
+
+    def _describe_again(self, node: str) -> None:
+        """``node``'s ``get_type_description`` appeared: ask it about the types it could not describe before."""
+        for info in self._undescribed.pop(node, []):
+            if info.token in self._remote and self._remote[info.token] is None:
+                self._descriptions.pop((info.type_name, info.type_hash), None)
+                del self._remote[info.token]
+                if not self._ask_description(info):
+                    self._remote[info.token] = None
 
     def _add_to_bus(self, endpoint: Any) -> None:
         assert self.bus is not None
@@ -943,6 +1043,7 @@ class ZenohTransport(Transport):
             self._remote[next(t for t, e in self._remote.items() if e is endpoint)] = None
 
     def _forget(self, token: str) -> None:
+        self._describing.pop(token, None)
         entry = self._remote.pop(token, None)
         self._remote_nodes.pop(token, None)
         bus = self.bus
