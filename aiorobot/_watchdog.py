@@ -20,6 +20,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
+import queue
 import sys
 import threading
 import time
@@ -82,7 +83,10 @@ class Watchdog:
 
     def __init__(self) -> None:
         self._watched: list[_Watched] = []
-        self._wake = threading.Event()
+        # Wakes the thread. A SimpleQueue, not a threading.Event: on_signal runs in a signal handler,
+        # which can interrupt the main thread inside Event.set() (holding the event's lock) and then
+        # wait on that lock for ever; SimpleQueue.put is reentrant, made for signal handlers.
+        self._wake: queue.SimpleQueue[None] = queue.SimpleQueue()
         self._closed = False
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -104,7 +108,7 @@ class Watchdog:
         with self._lock:
             self._watched.append(_Watched(name, loop, thread_id, threshold_sec))
         self._ensure_thread()
-        self._wake.set()
+        self._wake.put(None)
 
     def unwatch(self, loop: asyncio.AbstractEventLoop) -> None:
         with self._lock:
@@ -132,7 +136,7 @@ class Watchdog:
             self._forced = name
             self._deadline = time.monotonic()
         self._ensure_thread()
-        self._wake.set()
+        self._wake.put(None)
         return self._signals
 
     def finished(self) -> None:
@@ -143,7 +147,7 @@ class Watchdog:
 
     def close(self) -> None:
         self._closed = True
-        self._wake.set()
+        self._wake.put(None)
 
     def _ensure_thread(self) -> None:
         if self._thread is None and not self._closed:
@@ -170,8 +174,16 @@ class Watchdog:
                 wait = min(wait, w.threshold_sec / 2)
             if deadline is not None:
                 wait = min(wait, max(0.0, deadline - now))
-            self._wake.wait(wait)
-            self._wake.clear()
+            self._sleep(wait)
+
+    def _sleep(self, timeout_sec: float) -> None:
+        """Wait up to ``timeout_sec`` for a wake-up, then take every wake-up queued."""
+        try:
+            self._wake.get(timeout=timeout_sec)
+            while True:
+                self._wake.get_nowait()
+        except queue.Empty:
+            pass
 
     def _check(self, w: _Watched, now: float) -> None:
         sent = w.sent
