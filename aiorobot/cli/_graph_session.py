@@ -29,6 +29,9 @@ __all__ = [
 
 #: Discovery is complete once no liveliness token has arrived for this long.
 QUIET_SEC = 0.15
+#: with nothing discovered yet, wait this long before calling the graph empty: the session's link to
+#: the router can take longer than QUIET_SEC to come up, and `topic list` then printed nothing (1 run in 8)
+EMPTY_QUIET_SEC = 1.0
 DISCOVERY_MAX_SEC = 2.0
 
 
@@ -91,7 +94,7 @@ async def settle_discovery(transport: Any) -> None:
         now_seen = len(transport._remote)
         if now_seen != seen:
             seen, last_change = now_seen, time.monotonic()
-        elif time.monotonic() - last_change >= QUIET_SEC and not getattr(transport, "_describing", None):
+        elif time.monotonic() - last_change >= (QUIET_SEC if seen else EMPTY_QUIET_SEC) and not getattr(transport, "_describing", None):
             return  # quiet, and no remote node is still describing a type this process did not know
 
 
