@@ -730,8 +730,6 @@ class ZenohTransport(Transport):
 
     def _add_subscription(self, sub: Subscription[Any]) -> None:
         type_hash = self._hash(sub.msg_type)
-        if sub.node is not None:  # the runtime's /clock tap has no node: it receives without a graph entry
-            self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
         key = (sub.topic_name, sub.type_name)
         inb = self._inbound.get(key)
         new = inb is None
@@ -741,6 +739,10 @@ class ZenohTransport(Transport):
         if new and self.bus is not None:
             self.bus.add_publisher(inb.fallback)
         inb.declare(sub.qos)
+        # The zenoh subscriber first, then the liveliness token (as rmw_zenoh): a publisher that sees the
+        # token, and so counts the subscription as matched, finds the route to it already declared.
+        if sub.node is not None:  # the runtime's /clock tap has no node: it receives without a graph entry
+            self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
 
     def _inject(self, inbound: _Inbound, gid: bytes, msg: Any) -> None:
         """On the main loop: publish a received message into the bus as its remote publisher."""
