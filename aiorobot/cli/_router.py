@@ -13,7 +13,6 @@ import json
 import os
 import signal
 import sys
-import threading
 
 __all__ = ["add_arguments", "main"]
 
@@ -65,6 +64,11 @@ def main(args: argparse.Namespace) -> int:
     except ZenohConfigError as err:
         print(f"aiorobot router: error: {err}", file=sys.stderr)
         return 2
+    # SIGINT/SIGTERM are blocked here, so zenoh's threads inherit the mask, and taken by sigwait below:
+    # a handler that sets a threading.Event can interrupt the main thread inside that event's own
+    # lock and wait for ever (the watchdog's bug of the same shape)
+    stop_signals = {signal.SIGINT, signal.SIGTERM}
+    previous_mask = signal.pthread_sigmask(signal.SIG_BLOCK, stop_signals)
     try:
         session = zenoh.open(cfg)
     except Exception as err:  # noqa: BLE001 - zenoh raises ZError (a port in use, a listener it cannot make)
@@ -73,11 +77,10 @@ def main(args: argparse.Namespace) -> int:
             f"aiorobot router: error: cannot listen on {', '.join(plan.listen) or 'no endpoint'}{where}: {zenoh_error_text(err)}",
             file=sys.stderr,
         )
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous_mask)
         return 1
-    stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
     print(f"router {session.zid()} listening on {', '.join(plan.listen) or 'no endpoint'}", flush=True)
-    stop.wait()
+    signal.sigwait(stop_signals)
     session.close()
+    signal.pthread_sigmask(signal.SIG_SETMASK, previous_mask)
     return 0
