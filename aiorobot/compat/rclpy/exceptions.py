@@ -17,12 +17,16 @@ __all__ = [
     "InvalidHandle", "InvalidNamespaceException", "InvalidNodeNameException", "InvalidParameterTypeException",
     "InvalidParameterValueException", "InvalidServiceNameException", "InvalidTopicNameException",
     "NotInitializedException", "ParameterAlreadyDeclaredException", "ParameterImmutableException",
-    "ParameterNotDeclaredException", "ParameterUninitializedException",
+    "ParameterNotDeclaredException", "ParameterUninitializedException", "ROSInterruptException",
 ]
 
 
 class NotInitializedException(Exception):
     """rclpy.init() has not been called, or the context was shut down."""
+
+
+class ROSInterruptException(Exception):
+    """The program was interrupted (the context shut down) during a blocking call such as ``Rate.sleep``."""
 
 
 class InvalidHandle(RuntimeError):
