@@ -14,11 +14,13 @@ from __future__ import annotations
 import asyncio
 import collections
 import contextlib
+import functools
 import os
 import signal
 import sys
 import threading
 import time
+import weakref
 from collections.abc import Callable, Coroutine, Iterator
 from typing import Any, TypeVar
 
@@ -76,6 +78,7 @@ class Context:
         self._finished_waiters: list[asyncio.Future[None]] = []
         #: threads waiting while another executor spins in another thread (see _wait_beside)
         self._beside = threading.Condition()
+        self._exit_hook = False
 
     def __repr__(self) -> str:
         return f"<rclpy Context {'ok' if self._ok else 'shut down'} (aiorobot)>"
@@ -102,6 +105,12 @@ class Context:
             self.loop, self.runtime = loop, runtime
             self._ok, self._closed = True, False
             self._install_signal_handlers()
+            if not self._exit_hook:
+                self._exit_hook = True
+                try:  # before Python joins the non-daemon threads, as concurrent.futures registers its own
+                    threading._register_atexit(functools.partial(_at_exit, weakref.ref(self)))  # type: ignore[attr-defined]
+                except RuntimeError:  # pragma: no cover - init during interpreter shutdown
+                    pass
 
     def ok(self) -> bool:
         return self._ok
@@ -461,6 +470,43 @@ class Context:
         for sig, previous in self._saved_handlers.items():
             signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
         self._saved_handlers.clear()
+
+
+def _at_exit(ref: weakref.ref[Context]) -> None:
+    """The program's main thread has ended: end the context once the program's own threads have.
+
+    A program may end without ``rclpy.shutdown()`` (teleop_twist_keyboard does). With rclpy the
+    process then ends; here the runtime's zenoh session keeps non-daemon callback threads
+    (zenoh-python's) alive, so Python would wait for them forever, and the SIGTERM handler, which
+    only wakes a spin, could not end it either. Python calls this before it joins its threads:
+    it waits for the threads the program started (a spinner thread keeps the process, as with
+    rclpy), then shuts the context down, which closes the session and ends those threads. A
+    Ctrl-C meanwhile shuts down at once.
+    """
+    context = ref()
+    if context is None or context._closed:
+        return
+    me = threading.current_thread()
+    try:
+        while not context._closed:
+            waiting = [t for t in threading.enumerate() if t is not me and _program_thread(t)]
+            if not waiting:
+                break
+            waiting[0].join()
+    except KeyboardInterrupt:
+        pass
+    context.try_shutdown()
+
+
+def _program_thread(thread: threading.Thread) -> bool:
+    """A live non-daemon thread the program started (not zenoh's callback threads, not a thread pool's)."""
+    if thread.daemon or thread is threading.main_thread() or not thread.is_alive():
+        return False
+    if "pyo3-closure" in thread.name:  # zenoh-python's: they end when the session closes
+        return False
+    target = getattr(thread, "_target", None)
+    # thread pools (the runtime's, MultiThreadedExecutor's, asyncio's): concurrent.futures joins them itself
+    return not (getattr(target, "__module__", None) or "").startswith("concurrent.futures")
 
 
 def _run(loop: asyncio.AbstractEventLoop, coro: Coroutine[Any, Any, T]) -> T:
