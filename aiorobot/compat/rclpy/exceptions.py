@@ -18,6 +18,7 @@ __all__ = [
     "InvalidParameterValueException", "InvalidServiceNameException", "InvalidTopicNameException",
     "NotInitializedException", "ParameterAlreadyDeclaredException", "ParameterImmutableException",
     "ParameterNotDeclaredException", "ParameterUninitializedException", "ROSInterruptException",
+    "TimeSourceChangedError",
 ]
 
 
@@ -27,6 +28,10 @@ class NotInitializedException(Exception):
 
 class ROSInterruptException(Exception):
     """The program was interrupted (the context shut down) during a blocking call such as ``Rate.sleep``."""
+
+
+class TimeSourceChangedError(Exception):
+    """ROS time was switched on or off while an ``AsyncClock.sleep`` waited (rclpy's)."""
 
 
 class InvalidHandle(RuntimeError):
