@@ -244,11 +244,13 @@ class Context:
 
     def spin_until(
         self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool,
-        admissions: int | None = None,
+        admissions: int | None = None, beside: bool = False,
     ) -> bool:
         """Run the loop in this thread until ``done()`` or ``timeout_sec``; whether ``done()`` held.
 
         ``admissions`` caps how many program callbacks may start meanwhile (``spin_once``: 1).
+        ``beside``: when another thread runs the loop, wait for ``done()`` beside it (a blocking
+        call's wait) instead of raising as a second spin of the same executor does.
         """
         self.raise_if_interrupted()  # a Ctrl-C that came between two passes of a spin loop
         self.require_ok("spin")
@@ -261,9 +263,11 @@ class Context:
                     "(rclpy would deadlock here; use call_async / send_goal_async and a done callback)"
                 )
         if not self._spin_lock.acquire(blocking=False):
-            if self.executor is executor or executor is None:
+            if not beside and (self.executor is executor or executor is None):
                 raise RuntimeError("the executor is already spinning in another thread (rclpy raises here too)")
-            return self._wait_beside(done, timeout_sec, raise_on_shutdown=raise_on_shutdown)
+            return self._wait_beside(
+                executor, done, timeout_sec, raise_on_shutdown=raise_on_shutdown, admissions=admissions
+            )
         shut_by_callback = False
         try:
             self._bind_thread()
@@ -273,22 +277,27 @@ class Context:
                 nonlocal shut_by_callback
                 deadline = None if timeout_sec is None or timeout_sec < 0 else loop.time() + timeout_sec
                 await asyncio.sleep(0)
-                while True:
-                    if done():
-                        return True
-                    if not self._ok:
-                        shut_by_callback = getattr(self, "_shutdown_from_callback", False)
-                        return False
-                    remaining = None if deadline is None else deadline - loop.time()
-                    if remaining is not None and remaining <= 0:
-                        return False
-                    self._waiter = loop.create_future()
-                    try:
-                        await asyncio.wait_for(asyncio.shield(self._waiter), remaining)
-                    except TimeoutError:
-                        pass
-                    finally:
-                        self._waiter = None
+                try:
+                    while True:
+                        # The waiter exists before done() is asked: a wake() from another thread
+                        # right after the answer (an executor shut down, the condition met) finds
+                        # it. Made after, such a wake found none and was lost: the spin slept on
+                        # with its condition met (a spinner thread never saw rclpy.shutdown()).
+                        waiter = self._waiter = loop.create_future()
+                        if done():
+                            return True
+                        if not self._ok:
+                            shut_by_callback = getattr(self, "_shutdown_from_callback", False)
+                            return False
+                        remaining = None if deadline is None else deadline - loop.time()
+                        if remaining is not None and remaining <= 0:
+                            return False
+                        try:
+                            await asyncio.wait_for(asyncio.shield(waiter), remaining)
+                        except TimeoutError:
+                            pass
+                finally:
+                    self._waiter = None
 
             # before the loop runs: work queued while nobody spun (a message published from
             # the main thread) must not start ahead of the cap
@@ -310,7 +319,10 @@ class Context:
                 raise ExternalShutdownException()
         return result
 
-    def _wait_beside(self, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool) -> bool:
+    def _wait_beside(
+        self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool,
+        admissions: int | None = None,
+    ) -> bool:
         """Another executor spins in another thread: it runs the whole graph, so wait for ``done()``.
 
         rclpy lets two executors spin in two threads (use_logger_service.py spins one node in a
@@ -334,7 +346,12 @@ class Context:
             else:
                 return True
         remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
-        return self.spin_until(self.executor, done, remaining, raise_on_shutdown=raise_on_shutdown)
+        # the caller's own executor (not whichever spun last), and beside again should another
+        # thread take the loop first: the old self.executor here made that race raise "already
+        # spinning in another thread"
+        return self.spin_until(
+            executor, done, remaining, raise_on_shutdown=raise_on_shutdown, admissions=admissions, beside=True
+        )
 
     def run_sync(self, coro: Coroutine[Any, Any, T], what: str) -> T:
         """Run ``coro`` to its end from synchronous code (rclpy's blocking calls)."""
@@ -360,9 +377,12 @@ class Context:
             task = asyncio.ensure_future(coro, loop=loop)
             task.add_done_callback(lambda _t: self.wake())
 
-        loop.call_soon(start)
+        # thread-safe: another thread may start running the loop between the check above and
+        # here; a plain call_soon would then sit unseen while that loop sleeps in select(),
+        # and this blocking call would wait beside it forever
+        loop.call_soon_threadsafe(start)
         try:
-            self.spin_until(self.executor, done, None, raise_on_shutdown=False)
+            self.spin_until(self.executor, done, None, raise_on_shutdown=False, beside=True)
         except BaseException:
             if task is not None:
                 task.cancel()
