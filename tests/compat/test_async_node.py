@@ -127,6 +127,20 @@ async def test_parameter_services_answer_another_async_node(context):
         assert response.values[0].integer_value == 42
 
 
+async def test_the_logger_service_answers_another_async_node(context):
+    # ::test_enable_logger_service
+    from aiorobot.msgs.rcl_interfaces import GetLoggerLevels
+
+    async with AsyncNode("logger_svc", enable_logger_service=True, context=context) as srv_node, \
+            AsyncNode("logger_cli", context=context) as cli_node:
+        client = cli_node.create_client(GetLoggerLevels, "/logger_svc/get_logger_levels")
+        name = srv_node.get_logger().name
+        async with asyncio.timeout(5):
+            await client.wait_for_service()
+            response = await client.call(GetLoggerLevels.Request(names=[name]))
+        assert [level.name for level in response.levels] == [name]
+
+
 async def test_run_returns_when_destroyed(context):
     # ::test_run_basic
     node = AsyncNode("run_node", context=context)
