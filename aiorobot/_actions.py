@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import enum
+import functools
 import inspect
 import uuid
 from collections import deque
@@ -22,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 from ._future import Future, future_of
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ._qos import DurabilityPolicy, QoSProfile
-from ._services import ServiceUnavailableError
+from ._services import ServiceUnavailableError, after_reply
 
 if TYPE_CHECKING:
     from ._node import Node
@@ -286,12 +287,18 @@ class ActionServer:
         handle = ServerGoalHandle(self, request.goal_id, request.goal, stamp)
         self._goals[gid] = handle
         self._publish_status()
-        if self._handle_accepted_callback is None:
-            handle.execute()
-        else:
-            # after this handler returns, so the client has its answer first (as rclpy)
-            self.node._create_task(self._accepted(handle), name=f"goal {_gid_str(request.goal_id)} accepted")
+        # As rclpy: the goal response goes out first, then execute (or handle_accepted_callback)
+        # is scheduled. Started before, a plain execute callback that blocks the loop (rclpy
+        # programs sleep in theirs) would hold the response back until the goal had finished.
+        if not after_reply(functools.partial(self.node._call_soon, self._start, handle)):
+            self.node._loop.call_soon(self._start, handle)  # type: ignore[union-attr]  # not from the service
         return action.SendGoal.Response(accepted=True, stamp=stamp)
+
+    def _start(self, handle: ServerGoalHandle) -> None:
+        if self._handle_accepted_callback is not None:
+            self.node._create_task(self._accepted(handle), name=f"goal {_gid_str(handle.goal_id)} accepted")
+        elif handle.is_active and handle._task is None:  # not ended or started meanwhile
+            handle.execute()
 
     async def _accepted(self, handle: ServerGoalHandle) -> None:
         assert self._handle_accepted_callback is not None

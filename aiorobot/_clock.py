@@ -13,7 +13,7 @@ import heapq
 import itertools
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Coroutine
 from dataclasses import dataclass
 from typing import Any
 
@@ -315,13 +315,14 @@ class Clock:
         ns = rel_time.nanoseconds if isinstance(rel_time, Duration) else round(rel_time * 1e9)
         return await self.sleep_until(Time(nanoseconds=self.now_ns() + ns, clock_type=self.clock_type))
 
-    async def sleep_until(self, until: Time) -> bool:
-        """Sleep until this clock reads ``until``.
+    def sleep_until(self, until: Time) -> Coroutine[Any, Any, bool]:
+        """Sleep until this clock reads ``until``: ``await clock.sleep_until(t)``.
 
         Returns ``True`` when it was reached, ``False`` when ROS time was switched on or
         off meanwhile (the epoch changed, so the wait lost its meaning), as rclpy. Sim
         time jumping backwards keeps the wait going. Raises ``ValueError`` for a time of
-        another clock type.
+        another clock type ("clock type does not match", rclpy's words) at the call, before
+        anything is awaited.
 
         rclpy difference: a coroutine (rclpy's blocks the thread); cancelling the task is
         how a shutdown wakes it, so there is no ``context`` argument.
@@ -330,8 +331,12 @@ class Clock:
             raise TypeError(f"until: expected a Time, found {type(until).__name__}")
         if until.clock_type is not self.clock_type:
             raise ValueError(
-                f"until's clock type {until.clock_type.name} does not match this clock's {self.clock_type.name}"
+                f"sleep_until: clock type does not match: until is {until.clock_type.name}, "
+                f"this clock is {self.clock_type.name}"
             )
+        return self._sleep_until(until)
+
+    async def _sleep_until(self, until: Time) -> bool:
         loop = asyncio.get_running_loop()
         changed: asyncio.Future[None] = loop.create_future()
         with self._lock:

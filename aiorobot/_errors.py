@@ -19,7 +19,8 @@ __all__ = [
 class InvalidNameError(ValueError):
     """A topic, service, node or namespace name breaks ROS 2's naming rules.
 
-    The message quotes the name and points a caret at the offending character.
+    The message quotes the name, says it "is invalid" (the words rclpy's tests match) and
+    points a caret at the offending character.
     """
 
     def __init__(self, kind: str, name: str, reason: str, index: int | None = None) -> None:
@@ -27,7 +28,7 @@ class InvalidNameError(ValueError):
         self.name = name
         self.reason = reason
         self.index = index
-        text = f"invalid {kind} name {name!r}: {reason}"
+        text = f"{kind} name {name!r} is invalid: {reason}"
         if index is not None:
             text += f"\n  {name}\n  {' ' * index}^"
         super().__init__(text)

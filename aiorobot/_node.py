@@ -276,24 +276,34 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             raise TypeError(f"create_rate: expected a frequency in Hz (a number), found {frequency!r}")
         return Rate(self, frequency)
 
-    def destroy_rate(self, rate: Rate) -> None:
-        """Retire ``rate`` (rclpy's ``destroy_rate``); sleeping on it afterwards raises."""
+    def destroy_rate(self, rate: Rate) -> bool:
+        """Retire ``rate`` (rclpy's ``destroy_rate``): a task sleeping on it wakes, sleeping on it
+        afterwards raises. ``True`` if it was this node's and not destroyed yet, as rclpy."""
+        if rate.node is not self or rate.destroyed:
+            return False
         rate.destroy()
+        return True
 
-    def destroy_publisher(self, pub: Publisher[Any]) -> None:
+    def destroy_publisher(self, pub: Publisher[Any]) -> bool:
+        """Destroy ``pub``; ``True`` if it was this node's (and not destroyed yet), as rclpy."""
         if pub in self._publishers:
             self._publishers.remove(pub)
             pub.destroyed = True
             if self._runtime is not None:
                 self._runtime._bus.remove(pub)
             self._call_soon(pub._stop)
+            return True
+        return False
 
-    def destroy_subscription(self, sub: Subscription[Any]) -> None:
+    def destroy_subscription(self, sub: Subscription[Any]) -> bool:
+        """Destroy ``sub``; ``True`` if it was this node's (and not destroyed yet), as rclpy."""
         if sub in self._subscriptions:
             self._subscriptions.remove(sub)
             if self._runtime is not None:
                 self._runtime._bus.remove(sub)
             self._call_soon(self._close_subscription, sub)
+            return True
+        return False
 
     @staticmethod
     def _close_subscription(sub: Subscription[Any]) -> None:
@@ -306,12 +316,15 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         if waiter is not None and not waiter.done():
             waiter.set_result(None)
 
-    def destroy_timer(self, timer: Timer) -> None:
+    def destroy_timer(self, timer: Timer) -> bool:
+        """Destroy ``timer``; ``True`` if it was this node's (and not destroyed yet), as rclpy."""
         if timer in self._timers:
             self._timers.remove(timer)
             timer.destroyed = True
             timer._cancelled = True
             self._call_soon(self._close_timer, timer)
+            return True
+        return False
 
     @staticmethod
     def _close_timer(timer: Timer) -> None:
@@ -396,19 +409,25 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         """A client of action ``name``: ``handle = await client.send_goal(goal)``."""
         return ActionClient(self, action_type, name, callback_group=callback_group)
 
-    def destroy_service(self, service: Service) -> None:
+    def destroy_service(self, service: Service) -> bool:
+        """Destroy ``service``; ``True`` if it was this node's (and not destroyed yet), as rclpy."""
         if service in self._services:
             self._services.remove(service)
             if self._runtime is not None:
                 self._runtime._bus.services.remove(service)
             self._call_soon(service._close)
+            return True
+        return False
 
-    def destroy_client(self, client: Client) -> None:
+    def destroy_client(self, client: Client) -> bool:
+        """Destroy ``client``; ``True`` if it was this node's (and not destroyed yet), as rclpy."""
         if client in self._clients:
             self._clients.remove(client)
             client.destroyed = True
             if self._runtime is not None:
                 self._runtime._bus.services.remove(client)
+            return True
+        return False
 
     def destroy_node(self) -> None:
         """Take the node out of the graph, as rclpy's ``destroy_node``; calling it again does nothing.

@@ -10,6 +10,7 @@ caller that timed out has its future cancelled and a late reply is dropped.
 from __future__ import annotations
 
 import asyncio
+import contextvars
 import inspect
 import threading
 import uuid
@@ -77,6 +78,28 @@ class _Call:
     #: the calling client's GID and the call's sequence number (what introspection events carry)
     client_gid: bytes = bytes(16)
     sequence_number: int = 0
+    #: run on the caller's loop once the reply is handed on (see after_reply)
+    after: list[Callable[[], object]] = field(default_factory=list)
+
+
+#: the call whose handler runs in this task (so the handler can act after its reply, see after_reply)
+_CURRENT_CALL: contextvars.ContextVar[_Call | None] = contextvars.ContextVar("aiorobot_service_call", default=None)
+
+
+def after_reply(fn: Callable[[], object]) -> bool:
+    """From inside a service handler: call ``fn()`` once the handler's reply is on its way.
+
+    ``fn`` runs on the caller's loop after everything the reply set in motion there (the
+    local caller's wake-up, a transport's send of a remote reply): what an action server
+    needs to start executing a goal only after its client has the answer, as rclpy sends
+    the goal response before it schedules execute. ``False`` outside a handler (then
+    nothing is registered).
+    """
+    call = _CURRENT_CALL.get()
+    if call is None:
+        return False
+    call.after.append(fn)
+    return True
 
 
 class _ServiceEndpoint:
@@ -201,6 +224,7 @@ class Service(_ServiceEndpoint):
 
     async def _handle(self, call: _Call) -> None:
         self._event(_REQUEST_RECEIVED, call.client_gid, call.sequence_number, request=call.request)
+        token = _CURRENT_CALL.set(call)
         try:
             async with self.callback_group:
                 if self._with_response:
@@ -216,6 +240,8 @@ class Service(_ServiceEndpoint):
             self.node.get_logger().error(f"handler of service {self.srv_name} raised", exc_info=True)
             _reply(call, exc=ServiceError(f"service {self.srv_name} failed: {type(err).__name__}: {err}"))
             return
+        finally:
+            _CURRENT_CALL.reset(token)
         self.handled += 1
         if not isinstance(response, self.srv_type.Response):
             _reply(
@@ -242,12 +268,13 @@ class Service(_ServiceEndpoint):
 
 def _reply(call: _Call, *, result: Any = None, exc: BaseException | None = None) -> None:
     def deliver() -> None:
-        if call.future.done():
-            return  # timed out or cancelled: the late reply is dropped
-        if exc is not None:
-            call.future.set_exception(exc)
-        else:
-            call.future.set_result(result)
+        if not call.future.done():  # else timed out or cancelled: the late reply is dropped
+            if exc is not None:
+                call.future.set_exception(exc)
+            else:
+                call.future.set_result(result)
+        for fn in call.after:  # queued behind the callbacks the result just scheduled
+            call.loop.call_soon(fn)
 
     _call_on(call.loop, deliver)
 

@@ -356,6 +356,7 @@ class Rate:
         self.node = node
         self.period_ns = round(1e9 / frequency)
         self.destroyed = False
+        self._sleepers: set[asyncio.Future[None]] = set()
         # The grid starts at creation, as ROS's Rate; a node not yet running starts it at the first sleep.
         self._next_ns: int | None = self._now() + self.period_ns if node._loop is not None else None
 
@@ -367,8 +368,17 @@ class Rate:
         return clock.now_ns() if clock.use_sim_time else time.monotonic_ns()
 
     def destroy(self) -> None:
-        """Retire the rate (``Node.destroy_rate``): a later ``sleep()`` raises."""
+        """Retire the rate (``Node.destroy_rate``), from any thread.
+
+        A task sleeping on it wakes and its ``sleep()`` returns, as rclpy's ``Rate.destroy``
+        wakes its sleepers; a later ``sleep()`` raises ``RuntimeError``.
+        """
         self.destroyed = True
+        sleepers, self._sleepers = self._sleepers, set()
+        for fut in sleepers:
+            loop = fut.get_loop()
+            if not loop.is_closed():
+                loop.call_soon_threadsafe(_wake, fut)
 
     async def sleep(self) -> None:
         if self.destroyed:
@@ -381,13 +391,27 @@ class Rate:
         deadline = self._next_ns
         self._next_ns += self.period_ns
         clock = self.node._clock
+        # One future, resolved by whichever comes first: the deadline or destroy()
+        fut: asyncio.Future[None] = asyncio.get_running_loop().create_future()
         try:
             if clock.use_sim_time:
-                await clock.sleep_until_ns(deadline)
+                clock.add_waiter(deadline, fut)
             else:
                 waker = self.node._waker
                 if waker is None:
                     raise RuntimeError(f"{self!r}: the node is not added to a runtime")
-                await waker.wait_until_ns(deadline)
+                waker.add(deadline, fut)
+            self._sleepers.add(fut)
+            if self.destroyed:  # destroy() ran in another thread before the add
+                _wake(fut)
+            try:
+                await fut
+            finally:
+                self._sleepers.discard(fut)
         except ClockJump:
             self._next_ns = None
+
+
+def _wake(fut: asyncio.Future[None]) -> None:
+    if not fut.done():
+        fut.set_result(None)

@@ -14,11 +14,13 @@ from __future__ import annotations
 import asyncio
 import collections
 import contextlib
+import functools
 import os
 import signal
 import sys
 import threading
 import time
+import weakref
 from collections.abc import Callable, Coroutine, Iterator
 from typing import Any, TypeVar
 
@@ -76,6 +78,7 @@ class Context:
         self._finished_waiters: list[asyncio.Future[None]] = []
         #: threads waiting while another executor spins in another thread (see _wait_beside)
         self._beside = threading.Condition()
+        self._exit_hook = False
 
     def __repr__(self) -> str:
         return f"<rclpy Context {'ok' if self._ok else 'shut down'} (aiorobot)>"
@@ -102,6 +105,12 @@ class Context:
             self.loop, self.runtime = loop, runtime
             self._ok, self._closed = True, False
             self._install_signal_handlers()
+            if not self._exit_hook:
+                self._exit_hook = True
+                try:  # before Python joins the non-daemon threads, as concurrent.futures registers its own
+                    threading._register_atexit(functools.partial(_at_exit, weakref.ref(self)))  # type: ignore[attr-defined]
+                except RuntimeError:  # pragma: no cover - init during interpreter shutdown
+                    pass
 
     def ok(self) -> bool:
         return self._ok
@@ -235,11 +244,13 @@ class Context:
 
     def spin_until(
         self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool,
-        admissions: int | None = None,
+        admissions: int | None = None, beside: bool = False,
     ) -> bool:
         """Run the loop in this thread until ``done()`` or ``timeout_sec``; whether ``done()`` held.
 
         ``admissions`` caps how many program callbacks may start meanwhile (``spin_once``: 1).
+        ``beside``: when another thread runs the loop, wait for ``done()`` beside it (a blocking
+        call's wait) instead of raising as a second spin of the same executor does.
         """
         self.raise_if_interrupted()  # a Ctrl-C that came between two passes of a spin loop
         self.require_ok("spin")
@@ -252,9 +263,11 @@ class Context:
                     "(rclpy would deadlock here; use call_async / send_goal_async and a done callback)"
                 )
         if not self._spin_lock.acquire(blocking=False):
-            if self.executor is executor or executor is None:
+            if not beside and (self.executor is executor or executor is None):
                 raise RuntimeError("the executor is already spinning in another thread (rclpy raises here too)")
-            return self._wait_beside(done, timeout_sec, raise_on_shutdown=raise_on_shutdown)
+            return self._wait_beside(
+                executor, done, timeout_sec, raise_on_shutdown=raise_on_shutdown, admissions=admissions
+            )
         shut_by_callback = False
         try:
             self._bind_thread()
@@ -264,22 +277,27 @@ class Context:
                 nonlocal shut_by_callback
                 deadline = None if timeout_sec is None or timeout_sec < 0 else loop.time() + timeout_sec
                 await asyncio.sleep(0)
-                while True:
-                    if done():
-                        return True
-                    if not self._ok:
-                        shut_by_callback = getattr(self, "_shutdown_from_callback", False)
-                        return False
-                    remaining = None if deadline is None else deadline - loop.time()
-                    if remaining is not None and remaining <= 0:
-                        return False
-                    self._waiter = loop.create_future()
-                    try:
-                        await asyncio.wait_for(asyncio.shield(self._waiter), remaining)
-                    except TimeoutError:
-                        pass
-                    finally:
-                        self._waiter = None
+                try:
+                    while True:
+                        # The waiter exists before done() is asked: a wake() from another thread
+                        # right after the answer (an executor shut down, the condition met) finds
+                        # it. Made after, such a wake found none and was lost: the spin slept on
+                        # with its condition met (a spinner thread never saw rclpy.shutdown()).
+                        waiter = self._waiter = loop.create_future()
+                        if done():
+                            return True
+                        if not self._ok:
+                            shut_by_callback = getattr(self, "_shutdown_from_callback", False)
+                            return False
+                        remaining = None if deadline is None else deadline - loop.time()
+                        if remaining is not None and remaining <= 0:
+                            return False
+                        try:
+                            await asyncio.wait_for(asyncio.shield(waiter), remaining)
+                        except TimeoutError:
+                            pass
+                finally:
+                    self._waiter = None
 
             # before the loop runs: work queued while nobody spun (a message published from
             # the main thread) must not start ahead of the cap
@@ -301,7 +319,10 @@ class Context:
                 raise ExternalShutdownException()
         return result
 
-    def _wait_beside(self, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool) -> bool:
+    def _wait_beside(
+        self, executor: Any, done: Callable[[], bool], timeout_sec: float | None, *, raise_on_shutdown: bool,
+        admissions: int | None = None,
+    ) -> bool:
         """Another executor spins in another thread: it runs the whole graph, so wait for ``done()``.
 
         rclpy lets two executors spin in two threads (use_logger_service.py spins one node in a
@@ -325,7 +346,12 @@ class Context:
             else:
                 return True
         remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
-        return self.spin_until(self.executor, done, remaining, raise_on_shutdown=raise_on_shutdown)
+        # the caller's own executor (not whichever spun last), and beside again should another
+        # thread take the loop first: the old self.executor here made that race raise "already
+        # spinning in another thread"
+        return self.spin_until(
+            executor, done, remaining, raise_on_shutdown=raise_on_shutdown, admissions=admissions, beside=True
+        )
 
     def run_sync(self, coro: Coroutine[Any, Any, T], what: str) -> T:
         """Run ``coro`` to its end from synchronous code (rclpy's blocking calls)."""
@@ -351,9 +377,12 @@ class Context:
             task = asyncio.ensure_future(coro, loop=loop)
             task.add_done_callback(lambda _t: self.wake())
 
-        loop.call_soon(start)
+        # thread-safe: another thread may start running the loop between the check above and
+        # here; a plain call_soon would then sit unseen while that loop sleeps in select(),
+        # and this blocking call would wait beside it forever
+        loop.call_soon_threadsafe(start)
         try:
-            self.spin_until(self.executor, done, None, raise_on_shutdown=False)
+            self.spin_until(self.executor, done, None, raise_on_shutdown=False, beside=True)
         except BaseException:
             if task is not None:
                 task.cancel()
@@ -461,6 +490,43 @@ class Context:
         for sig, previous in self._saved_handlers.items():
             signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
         self._saved_handlers.clear()
+
+
+def _at_exit(ref: weakref.ref[Context]) -> None:
+    """The program's main thread has ended: end the context once the program's own threads have.
+
+    A program may end without ``rclpy.shutdown()`` (teleop_twist_keyboard does). With rclpy the
+    process then ends; here the runtime's zenoh session keeps non-daemon callback threads
+    (zenoh-python's) alive, so Python would wait for them forever, and the SIGTERM handler, which
+    only wakes a spin, could not end it either. Python calls this before it joins its threads:
+    it waits for the threads the program started (a spinner thread keeps the process, as with
+    rclpy), then shuts the context down, which closes the session and ends those threads. A
+    Ctrl-C meanwhile shuts down at once.
+    """
+    context = ref()
+    if context is None or context._closed:
+        return
+    me = threading.current_thread()
+    try:
+        while not context._closed:
+            waiting = [t for t in threading.enumerate() if t is not me and _program_thread(t)]
+            if not waiting:
+                break
+            waiting[0].join()
+    except KeyboardInterrupt:
+        pass
+    context.try_shutdown()
+
+
+def _program_thread(thread: threading.Thread) -> bool:
+    """A live non-daemon thread the program started (not zenoh's callback threads, not a thread pool's)."""
+    if thread.daemon or thread is threading.main_thread() or not thread.is_alive():
+        return False
+    if "pyo3-closure" in thread.name:  # zenoh-python's: they end when the session closes
+        return False
+    target = getattr(thread, "_target", None)
+    # thread pools (the runtime's, MultiThreadedExecutor's, asyncio's): concurrent.futures joins them itself
+    return not (getattr(target, "__module__", None) or "").startswith("concurrent.futures")
 
 
 def _run(loop: asyncio.AbstractEventLoop, coro: Coroutine[Any, Any, T]) -> T:

@@ -35,7 +35,7 @@ _MISSING_MODULES = frozenset(
         "rclpy.parameter_service",
         "rclpy.expand_topic_name", "rclpy.validate_topic_name",
         "rclpy.validate_node_name", "rclpy.validate_namespace", "rclpy.constants", "rclpy.type_hash",
-        "rclpy.time_source", "rclpy.experimental",
+        "rclpy.time_source",
     }
 )
 

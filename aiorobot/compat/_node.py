@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import functools
 import inspect
+import threading
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -70,28 +71,48 @@ class Client(_services.Client):
 
 
 class Rate:
-    """rclpy's ``Rate``: ``sleep()`` blocks the calling thread until the next period (absolute grid)."""
+    """rclpy's ``Rate``: ``sleep()`` blocks the calling thread until the next period (absolute grid).
 
-    def __init__(self, frequency: float) -> None:
+    As rclpy's, ``Node.destroy_rate`` wakes a thread sleeping on it (its ``sleep()`` returns),
+    a later ``sleep()`` raises ``RuntimeError``, and shutting the context down wakes a
+    sleeper with ``ROSInterruptException``.
+    """
+
+    def __init__(self, frequency: float, context: Context | None = None) -> None:
         if isinstance(frequency, bool) or not isinstance(frequency, (int, float)) or frequency <= 0:
             raise ValueError(f"Rate: expected a frequency in Hz > 0, found {frequency!r}")
         self._period = 1.0 / frequency
         self._next = time.monotonic() + self._period
         self._destroyed = False
+        self._is_shutdown = False
+        self._event = threading.Event()
+        if context is not None:
+            context.on_shutdown(self._on_shutdown)
+
+    def _on_shutdown(self) -> None:
+        self._is_shutdown = True
+        self.destroy()
 
     def sleep(self) -> None:
+        from .rclpy.exceptions import ROSInterruptException
+
+        if self._is_shutdown:
+            raise ROSInterruptException()
         if self._destroyed:
-            raise RuntimeError("Rate.sleep: the rate was destroyed")
+            raise RuntimeError("Rate cannot sleep because it has been destroyed")
         now = time.monotonic()
         if now >= self._next + self._period:
             self._next = now + self._period
         delay = self._next - now
         self._next += self._period
         if delay > 0:
-            time.sleep(delay)
+            self._event.wait(delay)
+        if self._is_shutdown:
+            raise ROSInterruptException()
 
     def destroy(self) -> None:
         self._destroyed = True
+        self._event.set()
 
 
 class NodeMixin:
@@ -227,10 +248,26 @@ class NodeMixin:
         return self._entity(timer, slot, callback_group)
 
     def create_rate(self, frequency: float, clock: Any = None) -> Rate:  # type: ignore[override]
-        return Rate(frequency)
+        if isinstance(frequency, bool) or not isinstance(frequency, (int, float)):
+            raise TypeError(f"create_rate: expected a frequency in Hz (a number), found {frequency!r}")
+        rate = Rate(frequency, self._context)
+        self._rates_list().append(rate)
+        return rate
 
-    def destroy_rate(self, rate: Any) -> None:  # type: ignore[override]
+    def destroy_rate(self, rate: Any) -> bool:  # type: ignore[override]
+        """rclpy's: wakes a thread sleeping on ``rate``; ``True`` if it was this node's and not
+        destroyed yet."""
+        if rate not in self._rates_list() or rate._destroyed:
+            return False
+        self._rates_list().remove(rate)
         rate.destroy()
+        return True
+
+    def _rates_list(self) -> list[Rate]:
+        rates = self.__dict__.get("_compat_rates")
+        if rates is None:
+            rates = self.__dict__["_compat_rates"] = []
+        return rates
 
     def create_service(  # type: ignore[override]
         self, srv_type: Any, srv_name: str, callback: Callable[..., Any], *, qos_profile: Any = None,
@@ -288,8 +325,12 @@ class NodeMixin:
         self._guards_list().append(guard)
         return guard
 
-    def destroy_guard_condition(self, guard: Any) -> None:
+    def destroy_guard_condition(self, guard: Any) -> bool:
+        """rclpy's: ``True`` if ``guard`` was this node's and is now destroyed."""
+        if guard not in self._guards_list():
+            return False
         guard.destroy()
+        return True
 
     def __getattr__(self, name: str) -> Any:
         if name in MISSING_NODE_METHODS:

@@ -210,7 +210,17 @@ def as_array(value: Any, dtype: np.dtype[Any]) -> np.ndarray:
         return value
     if isinstance(value, (bytes, bytearray, memoryview)) and dtype.itemsize == 1:
         return np.frombuffer(value, dtype).copy()
+    if dtype.itemsize == 1 and isinstance(value, (list, tuple)) and value and isinstance(value[0], bytes):
+        return _from_byte_list(value, dtype)
     return np.ascontiguousarray(value, dtype).reshape(-1)
+
+
+def _from_byte_list(value: list[Any] | tuple[Any, ...], dtype: np.dtype[Any]) -> np.ndarray:
+    """rclpy's ``byte[]`` form, a list of one-byte ``bytes`` (``[b'J', b'P']``), as an array."""
+    for i, b in enumerate(value):
+        if not isinstance(b, bytes) or len(b) != 1:
+            raise TypeError(f"item {i}: expected one-byte bytes (as the items before it), found {_got(b)}")
+    return np.frombuffer(b"".join(value), dtype).copy()
 
 
 def as_fixed_array(value: Any, dtype: np.dtype[Any], count: int, where: str) -> np.ndarray:

@@ -378,8 +378,8 @@ class ParameterStore:
             if not params:
                 return SetParametersResult(
                     False,
-                    "parameter list cannot be empty, this might be due to a pre-set parameters "
-                    "callback modifying the original list",
+                    "parameter list cannot be empty, this might be due to "
+                    "pre_set_parameters_callback modifying the original parameters list.",  # rclpy's words
                 )
         undeclared = [p.name for p in params if p.name not in self._values]
         if undeclared and not self.allow_undeclared:

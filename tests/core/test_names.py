@@ -85,5 +85,5 @@ def test_invalid_topic_is_rejected_when_creating_a_publisher():
     from aiorobot.msgs.std_msgs import String
 
     node = Node("n")
-    with pytest.raises(InvalidNameError, match=r"invalid topic name 'bad topic'"):
+    with pytest.raises(InvalidNameError, match=r"^topic name 'bad topic' is invalid: "):
         node.create_publisher(String, "bad topic", 10)

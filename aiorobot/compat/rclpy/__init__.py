@@ -133,7 +133,7 @@ _SUBMODULES = frozenset(
         "action", "callback_groups", "client", "clock", "duration", "exceptions", "executors",
         "logging", "node", "parameter", "publisher", "qos", "service", "subscription", "task", "time",
         "timer", "utilities", "signals", "context", "lifecycle", "serialization",
-        "parameter_client", "impl", "service_introspection",
+        "parameter_client", "impl", "service_introspection", "experimental",
     }
 )
 _missing = module_getattr(

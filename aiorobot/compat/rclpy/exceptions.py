@@ -17,12 +17,21 @@ __all__ = [
     "InvalidHandle", "InvalidNamespaceException", "InvalidNodeNameException", "InvalidParameterTypeException",
     "InvalidParameterValueException", "InvalidServiceNameException", "InvalidTopicNameException",
     "NotInitializedException", "ParameterAlreadyDeclaredException", "ParameterImmutableException",
-    "ParameterNotDeclaredException", "ParameterUninitializedException",
+    "ParameterNotDeclaredException", "ParameterUninitializedException", "ROSInterruptException",
+    "TimeSourceChangedError",
 ]
 
 
 class NotInitializedException(Exception):
     """rclpy.init() has not been called, or the context was shut down."""
+
+
+class ROSInterruptException(Exception):
+    """The program was interrupted (the context shut down) during a blocking call such as ``Rate.sleep``."""
+
+
+class TimeSourceChangedError(Exception):
+    """ROS time was switched on or off while an ``AsyncClock.sleep`` waited (rclpy's)."""
 
 
 class InvalidHandle(RuntimeError):

@@ -12,12 +12,15 @@ from ..._missing import module_getattr
 from ..._node import raw
 
 __all__ = [
-    "ActionClient", "ActionServer", "CancelResponse", "ClientGoalHandle", "GoalResponse", "GoalStatus",
+    "ActionClient", "ActionServer", "AsyncActionClient", "CancelResponse", "ClientGoalHandle", "GoalResponse", "GoalStatus",
     "ServerGoalHandle",
 ]
 
 
 def _wrap(node: Any, callback: Any) -> Any:
+    bridge = getattr(node, "_bridge_callback", None)
+    if bridge is not None:  # an AsyncNode: the callback runs on the program's loop
+        return bridge(callback)
     wrap = getattr(node, "_wrap", None)
     return callback if wrap is None or callback is None else wrap(callback)[0]
 
@@ -46,7 +49,15 @@ class ActionServer(_actions.ActionServer):
 
 
 class ActionClient(_actions.ActionClient):
-    """rclpy's ``ActionClient(node, action_type, action_name)``: ``wait_for_server`` blocks."""
+    """rclpy's ``ActionClient(node, action_type, action_name)``: ``wait_for_server`` blocks.
+
+    On an ``rclpy.experimental.AsyncNode`` it is an :class:`AsyncActionClient`, which awaits.
+    """
+
+    def __new__(cls, node: Any, *args: Any, **kwargs: Any) -> Any:
+        if cls is ActionClient and getattr(node, "_bridge_callback", None) is not None:
+            cls = AsyncActionClient
+        return super().__new__(cls)
 
     def __init__(self, node: Any, action_type: Any, action_name: str, *, callback_group: Any = None, **qos: Any) -> None:
         with raw(node):
@@ -84,6 +95,34 @@ class ActionClient(_actions.ActionClient):
             return await handle._result_response()
 
         return self.node._context.run_sync(run(), "ActionClient.send_goal")
+
+
+class AsyncActionClient(ActionClient):
+    """An action client of an AsyncNode: its calls are awaited on the program's loop.
+
+    ``await wait_for_server()``, ``await send_goal_async(goal, feedback_callback)`` (the goal
+    handle), ``await handle.get_result_async()`` / ``cancel_goal_async()``, and
+    ``await send_goal(goal)`` (the ``GetResult`` response); feedback callbacks run on the
+    program's loop, as the node's other callbacks.
+    """
+
+    def _loop_for_futures(self) -> Any:
+        return self.node._context.loop  # the work runs on the context's loop; the futures are awaited anywhere
+
+    async def wait_for_server(self, timeout_sec: float | None = None) -> bool:  # type: ignore[override]
+        import asyncio
+
+        loop = self._loop_for_futures()
+        if loop is None:
+            raise RuntimeError("ActionClient.wait_for_server: the context was shut down")
+        waiting = asyncio.run_coroutine_threadsafe(_actions.ActionClient.wait_for_server(self, timeout_sec), loop)
+        return bool(await asyncio.wrap_future(waiting))
+
+    async def send_goal(self, goal: Any, **kwargs: Any) -> Any:  # type: ignore[override]
+        handle = await self.send_goal_async(goal, kwargs.get("feedback_callback"), kwargs.get("goal_uuid"))
+        if not handle.accepted:
+            return None
+        return await handle.get_result_async()
 
 
 _orig_get_result_async = ClientGoalHandle.get_result_async

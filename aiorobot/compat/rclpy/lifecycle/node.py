@@ -208,16 +208,16 @@ class LifecycleNodeMixin(ManagedEntity):
         self._managed_entities.add(pub)
         return pub
 
-    def destroy_lifecycle_publisher(self, publisher: LifecyclePublisher[Any]) -> None:
+    def destroy_lifecycle_publisher(self, publisher: LifecyclePublisher[Any]) -> bool:
         self._managed_entities.discard(publisher)
-        self.destroy_publisher(publisher)
+        return self.destroy_publisher(publisher)
 
-    def destroy_publisher(self, publisher: Any) -> None:
+    def destroy_publisher(self, publisher: Any) -> bool:
         """Also takes a :class:`LifecyclePublisher` (as rclpy), which stops being managed."""
         if isinstance(publisher, LifecyclePublisher):
             self._managed_entities.discard(publisher)
             publisher = publisher.publisher
-        super().destroy_publisher(publisher)  # type: ignore[misc]
+        return bool(super().destroy_publisher(publisher))  # type: ignore[misc]
 
     # -- the transition itself ------------------------------------------------------------------
 

@@ -1,0 +1,169 @@
+"""rclpy programs end as they do with rclpy, also over zenoh (issue 26 item 11).
+
+A program that ends without ``rclpy.shutdown()`` used to hang over zenoh: the session's
+callback threads are non-daemon, so Python waited for them forever and SIGTERM could not end
+it. teleop_twist_keyboard is such a program: it reads keys from a tty in raw mode and leaves
+its loop on the Ctrl-C byte (0x03), without shutting rclpy down.
+"""
+
+from __future__ import annotations
+
+import os
+import pty
+import signal
+import subprocess
+import sys
+import termios
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+from ._run import FIXTURES, ROOT, WAIT_SEC, Program
+from .test_mixed_zenoh import router  # noqa: F401 - the zenoh router fixture
+
+# in the style of teleop_twist_keyboard.py: raw tty reads, Ctrl-C byte ends the loop, no shutdown
+TELEOP = textwrap.dedent("""
+    import sys, termios, tty
+    import geometry_msgs.msg
+    import rclpy
+
+    def get_key(settings):
+        tty.setraw(sys.stdin.fileno())
+        key = sys.stdin.read(1)
+        termios.tcsetattr(sys.stdin, termios.TCSADRAIN, settings)
+        return key
+
+    settings = termios.tcgetattr(sys.stdin)
+    rclpy.init()
+    node = rclpy.create_node('teleop_keys')
+    pub = node.create_publisher(geometry_msgs.msg.Twist, 'cmd_vel', 10)
+    try:
+        print('reading keys', flush=True)
+        while True:
+            key = get_key(settings)
+            twist = geometry_msgs.msg.Twist()
+            if key == 'i':
+                twist.linear.x = 0.5
+            elif key == '\\x03':
+                break
+            pub.publish(twist)
+            print('key', repr(key), flush=True)
+    finally:
+        pub.publish(geometry_msgs.msg.Twist())
+        termios.tcsetattr(sys.stdin, termios.TCSADRAIN, settings)
+        print('loop left', flush=True)
+""")
+
+SPINNER_THREAD = textwrap.dedent("""
+    import threading
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+
+    rclpy.init()
+    node = rclpy.create_node('spinner')
+    ticks = []
+    node.create_timer(0.05, lambda: ticks.append(1) or (len(ticks) == 3 and print('ticking after main', flush=True)))
+
+    def spin():
+        try:
+            rclpy.spin(node)
+        except ExternalShutdownException:
+            print('spin ended by SIGTERM', flush=True)
+
+    threading.Thread(target=spin).start()
+    print('main ends', flush=True)
+""")
+
+
+def _env(endpoint: str) -> dict[str, str]:
+    env = dict(os.environ)
+    env["ZENOH_CONFIG_OVERRIDE"] = f'connect/endpoints=["{endpoint}"]'
+    env["PYTHONPATH"] = os.pathsep.join([str(FIXTURES), str(ROOT), env.get("PYTHONPATH", "")])
+    env["PYTHONUNBUFFERED"] = "1"
+    return env
+
+
+def _wait_for_raw_mode(controller: int) -> None:
+    """Until the program has put its terminal in raw mode (polled, generous bound)."""
+    deadline = time.monotonic() + WAIT_SEC
+    while termios.tcgetattr(controller)[3] & termios.ICANON:
+        assert time.monotonic() < deadline, "the program never put its terminal in raw mode"
+        time.sleep(0.01)
+
+
+def test_a_teleop_program_leaves_on_the_ctrl_c_byte_and_exits_over_zenoh(router, tmp_path: Path):  # noqa: F811
+    script = tmp_path / "teleop_keys.py"
+    script.write_text(TELEOP)
+    controller, terminal = pty.openpty()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "aiorobot.cli", "exec", "--transport", "zenoh", str(script)],
+        stdin=terminal, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=_env(router), cwd=tmp_path,
+    )
+    os.close(terminal)
+    lines: list[str] = []
+    seen = threading.Condition()
+
+    def read() -> None:
+        assert proc.stdout is not None
+        with proc.stdout:
+            for raw in proc.stdout:
+                with seen:
+                    lines.append(raw.decode(errors="replace").rstrip())
+                    seen.notify_all()
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    try:
+        with seen:
+            assert seen.wait_for(lambda: "reading keys" in lines, WAIT_SEC), lines
+        _wait_for_raw_mode(controller)  # tty.setraw flushes what was typed before it
+        os.write(controller, b"i")
+        with seen:
+            assert seen.wait_for(lambda: "key 'i'" in lines, WAIT_SEC), lines
+        _wait_for_raw_mode(controller)
+        os.write(controller, b"\x03")  # what a terminal in raw mode gives for Ctrl-C: a byte, no signal
+        code = proc.wait(WAIT_SEC)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        os.close(controller)
+        reader.join(5)
+    assert code == 0, lines
+    assert "loop left" in lines and not any("Traceback" in line for line in lines), lines
+
+
+def test_a_spinner_thread_keeps_the_program_until_sigterm_ends_it(router, tmp_path: Path):  # noqa: F811
+    script = tmp_path / "spinner_thread.py"
+    script.write_text(SPINNER_THREAD)
+    program = Program(
+        str(script), exec_args=("--transport", "zenoh"),
+        extra_env={"ZENOH_CONFIG_OVERRIDE": f'connect/endpoints=["{router}"]'},
+    )
+    program.wait_for("main ends", "ticking after main")  # as with rclpy: the thread spins on
+    program.proc.send_signal(signal.SIGTERM)
+    assert program.finish() == 0, program.output
+    assert "spin ended by SIGTERM" in program.output
+    assert "Traceback" not in program.output, program.output
+
+
+def test_a_program_ending_without_shutdown_exits_on_every_transport(router, tmp_path: Path):  # noqa: F811
+    script = tmp_path / "no_shutdown.py"
+    script.write_text(textwrap.dedent("""
+        import rclpy
+        from std_msgs.msg import String
+        rclpy.init()
+        node = rclpy.create_node('no_shutdown')
+        node.create_subscription(String, 'chatter', print, 10)
+        node.create_publisher(String, 'chatter', 10).publish(String(data='hello'))
+        rclpy.spin_once(node, timeout_sec=5.0)
+        print('main ends', flush=True)
+    """))
+    for transport in ("zenoh", "local"):
+        program = Program(
+            str(script), exec_args=("--transport", transport),
+            extra_env={"ZENOH_CONFIG_OVERRIDE": f'connect/endpoints=["{router}"]'},
+        )
+        assert program.finish() == 0, (transport, program.output)
+        assert "main ends" in program.output, (transport, program.output)
