@@ -68,8 +68,9 @@ SPINNER_THREAD = textwrap.dedent("""
     def spin():
         try:
             rclpy.spin(node)
-        except ExternalShutdownException:
-            print('spin ended by SIGTERM', flush=True)
+        except ExternalShutdownException:  # or spin returns: rclpy ends it either way on shutdown
+            pass
+        print('spin ended by SIGTERM', flush=True)
 
     threading.Thread(target=spin).start()
     print('main ends', flush=True)
