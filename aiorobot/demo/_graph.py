@@ -157,7 +157,11 @@ def build_graph(
             "alpha1": 0.05, "alpha2": 0.05, "alpha3": 0.05, "alpha4": 0.05, "alpha5": 0.05, "sigma_hit": 0.1,
         }))
     else:
-        g.landmark_fixes = g.add(LandmarkFixNode(parameter_overrides={"world": world_ref, "max_range_m": 6.0}))
+        from aiorobot.nav import landmark_map_path
+        from aiorobot.sim import builtin_world_path
+
+        landmark_map = str(landmark_map_path(world.path or builtin_world_path(world.name)))
+        g.landmark_fixes = g.add(LandmarkFixNode(parameter_overrides={"landmark_map": landmark_map, "max_range_m": 6.0}))
         g.add(EkfNode("ekf_global", namespace="global",
                       parameter_overrides=_ekf_parameters("map", pose=True, start=start)), "priority")
     if perception:

@@ -20,6 +20,15 @@ from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, plan
 from ._amcl_node import AmclNode
 from ._geometry import pose_stamped
+from ._landmark_map import (
+    LANDMARK_MAP_SUFFIX,
+    LandmarkMap,
+    LandmarkMapError,
+    MarkerPlace,
+    landmark_map_path,
+    load_landmark_map,
+    save_landmark_map,
+)
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
 from ._map_server import MapServer
 from ._mapping import MappingNode, OccupancyMapper
@@ -30,6 +39,13 @@ from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 __all__ = [
     "AmclNode",
     "LandmarkFixNode",
+    "LANDMARK_MAP_SUFFIX",
+    "LandmarkMap",
+    "LandmarkMapError",
+    "MarkerPlace",
+    "landmark_map_path",
+    "load_landmark_map",
+    "save_landmark_map",
     "base_pose_from_marker",
     "base_pose_from_markers",
     "map_from_marker",

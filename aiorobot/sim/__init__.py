@@ -19,7 +19,7 @@ from ._sensors import GRAVITY, ImuModel, LidarModel
 from ._start import StartChoice, nearest_free_spot, parse_start, resolve_start
 from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TIME_SOURCES, TOPICS, Simulator
 from ._world import BUILTIN_WORLDS, Landmark, World, WorldError, builtin_world_path
-from ._world_file import load_world, save_world
+from ._world_file import export_landmark_map, load_world, save_world
 
 __all__ = [
     "BUILTIN_WORLDS",
@@ -45,6 +45,7 @@ __all__ = [
     "builtin_world_path",
     "camera_pose_matrix",
     "clearance_map",
+    "export_landmark_map",
     "load_world",
     "make_box",
     "make_kinematics",
