@@ -32,7 +32,7 @@ from ._landmark_map import (
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
 from ._map_server import MapServer
 from ._mapping import MappingNode, OccupancyMapper
-from ._navigation_server import NavigationServer
+from ._navigation_server import NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
@@ -53,6 +53,7 @@ __all__ = [
     "MappingNode",
     "OccupancyMapper",
     "NavigationServer",
+    "NavigationStatistics",
     "Navigator",
     "TaskResult",
     "pose_stamped",

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -39,7 +39,19 @@ from ._maps import OccupancyMap
 from ._planner import Plan, PlanError, plan
 from ._rpp import RegulatedPurePursuit, RppParameters
 
-__all__ = ["NavigationServer"]
+__all__ = ["NavigationServer", "NavigationStatistics"]
+
+
+@dataclass(frozen=True, slots=True)
+class NavigationStatistics:
+    """What :meth:`NavigationServer.statistics` reports (a snapshot)."""
+
+    #: recoveries run for the current goal (or the last one), as the feedback's number_of_recoveries
+    recoveries: int
+    #: a navigation goal is being executed
+    navigating: bool
+    #: why the latest pose estimate counts as lost; None when fine or none seen
+    localization_lost: str | None
 
 
 def _accept_cancel(_handle: Any) -> Any:
@@ -116,6 +128,10 @@ class NavigationServer(Node):
         self.create_action_server(ComputePathToPose, "compute_path_to_pose", self._compute_path, cancel_callback=_accept_cancel)
         self.last_plan: Plan | None = None
         self.recoveries = 0
+
+    def statistics(self) -> NavigationStatistics:
+        """Recoveries of the current or last goal, whether one is running, the localisation state."""
+        return NavigationStatistics(self.recoveries, self._busy, self.localization_lost)
 
     # -- inputs -------------------------------------------------------------------------
 
