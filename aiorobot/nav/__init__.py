@@ -17,7 +17,7 @@ from ._costmap import (
     inflation_cost,
 )
 from ._maps import MapError, OccupancyMap, load_map, save_map
-from ._planner import Plan, PlanError, plan
+from ._planner import Plan, PlanError, PlanFailure, plan
 from ._amcl_node import AmclNode
 from ._geometry import pose_stamped
 from ._landmark_map import (
@@ -32,7 +32,7 @@ from ._landmark_map import (
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
 from ._map_server import MapServer
 from ._mapping import MappingNode, OccupancyMapper
-from ._navigation_server import NavigationServer, NavigationStatistics
+from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
@@ -52,6 +52,7 @@ __all__ = [
     "MapServer",
     "MappingNode",
     "OccupancyMapper",
+    "NavigationFailure",
     "NavigationServer",
     "NavigationStatistics",
     "Navigator",
@@ -68,6 +69,7 @@ __all__ = [
     "Costmap",
     "Plan",
     "PlanError",
+    "PlanFailure",
     "RegulatedPurePursuit",
     "RppCommand",
     "RppParameters",
