@@ -3,7 +3,9 @@
 Main loop: the simulator, the serial motor bridge (``drive = "serial"``), AMCL or the landmark
 fixes, perception's front ends (ArUco in a worker process, lidar segmentation in the thread pool),
 the navigation server and the navigator. Priority loop: the mecanum base controller (serial
-drive) and the EKFs (robot_localization's dual set-up, ``examples/fusion_ekf.toml``).
+drive) and the EKFs (robot_localization's dual set-up, ``dual_ekf.yaml``, which
+``examples/fusion_ekf.toml`` shares). The nodes and their fixed parameters are in ``graph.toml``
+(:data:`GRAPH_FILE`); :func:`build_graph` picks those the options ask for and adds the run's own.
 
 Time: at real-time factor 1 the graph runs on system time, as on a robot (the simulator stamps
 with system time and publishes no ``/clock``; every timer keeps its own deadlines); at any other
@@ -12,9 +14,11 @@ factor, lock-step 0 included, the simulator owns sim time and every node follows
 
 from __future__ import annotations
 
+import importlib
 import os
 import tempfile
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 __all__ = ["DRIVES", "LOCALISATIONS", "ROBOT_RADIUS", "DemoGraph", "build_graph", "time_source_for"]
@@ -26,15 +30,12 @@ DRIVES = ("direct", "serial")
 LOCALISATIONS = ("amcl", "landmarks")
 #: The simulated robot's footprint radius (m): the simulator's default, what a start or a waypoint must leave free.
 ROBOT_RADIUS = 0.22
-#: Rate of the priority loop's control timer (the base controller, or the odom EKF with direct drive).
-CONTROL_HZ = 50.0
-
-_TWIST_XY_YAW = [False] * 6 + [True, True, False, False, False, True] + [False] * 3
-_YAW_RATE = [False] * 11 + [True] + [False] * 3
-#: landmark fixes: x, y, and yaw (measured by fixes from two or more markers; a one-marker fix's yaw
-#: carries a variance of 1e6, so it adds nothing)
-_POSE_XY_YAW = [True, True] + [False] * 3 + [True] + [False] * 9
-_PROCESS_NOISE = [1e-4, 1e-4, 0.06, 0.03, 0.03, 1e-4, 0.025, 0.025, 0.04, 0.01, 0.01, 0.02, 0.01, 0.01, 0.015]
+#: The demo's graph: every node it may run, with the parameters no option changes (build_graph picks and adds).
+GRAPH_FILE = Path(__file__).with_name("graph.toml")
+#: node name in GRAPH_FILE -> the DemoGraph attribute that holds it
+_ROLES = {"simulator": "simulator", "mecanum_controller": "control_node", "ekf_local": "ekf_local",
+          "landmark_fixes": "landmark_fixes", "aruco": "aruco", "scan_obstacles": "scan_obstacles",
+          "navigation_server": "server"}
 
 
 @dataclass
@@ -46,6 +47,7 @@ class DemoGraph:
     server: Any = None
     control_node: Any = None
     aruco: Any = None
+    ekf_local: Any = None
     scan_obstacles: Any = None
     landmark_fixes: Any = None
     recorder: Any = None
@@ -63,22 +65,27 @@ def time_source_for(rtf: float) -> str:
     return "system" if rtf == 1.0 else "sim"
 
 
-def _ekf_parameters(world_frame: str, *, pose: bool, start: tuple[float, float, float]) -> dict[str, Any]:
-    params: dict[str, Any] = {
-        "frequency": CONTROL_HZ, "sensor_timeout": 0.1, "two_d_mode": True, "publish_tf": True,
-        "map_frame": "map", "odom_frame": "odom", "base_link_frame": "base_link", "world_frame": world_frame,
-        "odom0": "/odom", "odom0_config": _TWIST_XY_YAW, "odom0_queue_size": 10,
-        "imu0": "/imu/data", "imu0_config": _YAW_RATE, "imu0_queue_size": 20,
-        "imu0_remove_gravitational_acceleration": True,
-        "smooth_lagged_data": True, "history_length": 1.0, "process_noise_covariance": _PROCESS_NOISE,
-    }
-    if pose:
-        x, y, yaw = start
-        params.update({
-            "pose0": "/landmark_pose", "pose0_config": _POSE_XY_YAW, "pose0_rejection_threshold": 5.0,
-            "initial_state": [x, y, 0.0, 0.0, 0.0, yaw] + [0.0] * 9,
-        })
-    return params
+def _construct(spec: Any, run_parameters: dict[str, Any]) -> Any:
+    """Construct the node of one ``[[nodes]]`` table of :data:`GRAPH_FILE` with the run's parameters added.
+
+    As ``aiorobot run`` builds a node (the table's name and namespace, its parameters over its
+    parameters_file), without wrapping the node's own errors: the demo reports those as they are.
+    """
+    module_name, _, class_name = spec.use.partition(":")
+    cls = getattr(importlib.import_module(module_name), class_name)
+    parameters = {k: list(v) if isinstance(v, tuple) else v for k, v in spec.parameters.items()}
+    parameters.update(run_parameters)
+    kwargs: dict[str, Any] = {"parameter_overrides": parameters, "remappings": {"__node": spec.name}}
+    if spec.namespace:
+        kwargs["namespace"] = spec.namespace
+    if spec.parameters_file:
+        kwargs["cli_args"] = ["--ros-args", "--params-file", spec.parameters_file]
+    node = cls(**kwargs)
+    unclaimed = sorted(node.unclaimed_parameter_overrides())
+    if unclaimed:
+        raise ValueError(f"{GRAPH_FILE}: {spec.key}.parameters: expected parameters {spec.use} declares, "
+                         f"found {', '.join(unclaimed)}")
+    return node
 
 
 def build_graph(
@@ -102,9 +109,8 @@ def build_graph(
     ``time_source`` (``sim`` or ``system``, the simulator's parameter) defaults to
     :func:`time_source_for` ``(rtf)``; the runtime must use sim time exactly when it is ``sim``.
     """
-    from aiorobot.fusion import EkfNode
-    from aiorobot.nav import AmclNode, LandmarkFixNode, NavigationServer
-    from aiorobot.sim import Simulator, resolve_start
+    from aiorobot import load_config
+    from aiorobot.sim import builtin_world_path, resolve_start
 
     if drive not in DRIVES:
         raise ValueError(f"drive: expected one of {', '.join(DRIVES)}, found {drive!r}")
@@ -123,50 +129,41 @@ def build_graph(
     start = resolve_start(world, start, ROBOT_RADIUS).pose  # checked whether given or not
     g = DemoGraph(time_source=time_source_for(rtf) if time_source is None else time_source)
     world_ref = str(world.path) if world.path else world.name
-    sim_params: dict[str, Any] = {
-        "world": world_ref, "robot": "mecanum", "seed": seed, "real_time_factor": rtf,
-        "publish_odom_tf": False, "camera_rate": 15.0 if perception else 0.0,
-        "drive": "serial" if drive == "serial" else "cmd_vel", "time_source": g.time_source,
-        "start": list(start), "robot_radius": ROBOT_RADIUS,
+    sx, sy, syaw = start
+    run: dict[str, dict[str, Any]] = {
+        "simulator": {
+            "world": world_ref, "seed": seed, "real_time_factor": rtf, "camera_rate": 15.0 if perception else 0.0,
+            "drive": "serial" if drive == "serial" else "cmd_vel", "time_source": g.time_source,
+            "start": list(start), "robot_radius": ROBOT_RADIUS,
+        },
+        "ekf_local": {},
+        "navigation_server": {},
     }
     if drive == "serial":
         g.port_link = os.path.join(tempfile.gettempdir(), f"aiorobot-demo-motors-{os.getpid()}")
-        sim_params["port_link"] = g.port_link
+        run["simulator"]["port_link"] = g.port_link
+        run["serial_motor_bridge"] = {"port": g.port_link}
+        run["mecanum_controller"] = {}
+    if localisation == "amcl":
+        run["amcl"] = {"initial_pose.x": sx, "initial_pose.y": sy, "initial_pose.yaw": syaw, "seed": seed}
+    else:
+        from aiorobot.nav import landmark_map_path
+
+        run["landmark_fixes"] = {"landmark_map": str(landmark_map_path(world.path or builtin_world_path(world.name)))}
+        run["ekf_global"] = {"initial_state": [sx, sy, 0.0, 0.0, 0.0, syaw] + [0.0] * 9}
+    if perception:
+        run["aruco"] = {}
+        run["scan_obstacles"] = {}
     if record is not None:
         from aiorobot.bag import Recorder
 
         # first, so it taps every topic from its first message; raw camera frames (0.9 MB each) stay out
         g.recorder = g.add(Recorder(path=record, all_topics=True, exclude=r"^/camera/image_raw$"))
-    g.simulator = g.add(Simulator(parameter_overrides=sim_params))
-    if drive == "serial":
-        from aiorobot.control import MecanumController, SerialMotorBridge
-
-        g.add(SerialMotorBridge(parameter_overrides={"port": g.port_link, "reconnect_period_sec": 0.2}))
-        g.control_node = g.add(MecanumController(parameter_overrides={
-            "publish_tf": False, "rate_hz": CONTROL_HZ, "max_linear_x": 0.6, "max_linear_y": 0.6}), "priority")
-    ekf_local = g.add(EkfNode("ekf_local", namespace="local",
-                              parameter_overrides=_ekf_parameters("odom", pose=False, start=start)), "priority")
-    if g.control_node is None:
-        g.control_node = ekf_local
-    if localisation == "amcl":
-        sx, sy, syaw = start
-        g.add(AmclNode(parameter_overrides={
-            "robot_model_type": "omnidirectional", "set_initial_pose": True,
-            "initial_pose.x": sx, "initial_pose.y": sy, "initial_pose.yaw": syaw,
-            "update_min_d": 0.05, "update_min_a": 0.05, "min_particles": 300, "max_particles": 1000, "seed": seed,
-            "alpha1": 0.05, "alpha2": 0.05, "alpha3": 0.05, "alpha4": 0.05, "alpha5": 0.05, "sigma_hit": 0.1,
-        }))
-    else:
-        g.landmark_fixes = g.add(LandmarkFixNode(parameter_overrides={"world": world_ref, "max_range_m": 6.0}))
-        g.add(EkfNode("ekf_global", namespace="global",
-                      parameter_overrides=_ekf_parameters("map", pose=True, start=start)), "priority")
-    if perception:
-        from aiorobot.perception import ArucoNode, ScanObstacleNode
-
-        g.aruco = g.add(ArucoNode(parameter_overrides={
-            "workers": 1, "queue": 1, "policy": "latest", "marker_length": 0.2, "dictionary": "DICT_4X4_50"}))
-        g.scan_obstacles = g.add(ScanObstacleNode(parameter_overrides={
-            "break_distance": 0.2, "min_points": 3, "max_radius": 1.0}))
-    g.server = g.add(NavigationServer(parameter_overrides={
-        "desired_linear_vel": 0.5, "stop_on_failure": False, "movement_time_allowance": 15.0}))
+    for spec in load_config(GRAPH_FILE).nodes:
+        if spec.name in run:
+            node = g.add(_construct(spec, run[spec.name]), spec.executor)
+            if spec.name in _ROLES:
+                setattr(g, _ROLES[spec.name], node)
+    if g.control_node is None:  # direct drive: the odometry EKF's timer is the priority loop's control timer
+        g.control_node = g.ekf_local
     return g

@@ -374,7 +374,7 @@ async def run_demo(
         try:
             while not (started.done() and nav.is_task_complete()):
                 await asyncio.sleep(0.05)
-                now = sim.time_ns / 1e9  # the simulator's elapsed time, on either time source
+                now = sim.statistics().sim_sec  # the simulator's elapsed time, on either time source
                 if duration_sim_sec is not None and now >= duration_sim_sec and duration_sim_sec <= timeout_sim_sec:
                     summary.stopped_by_duration = True
                     await nav.cancel_task()
@@ -403,9 +403,10 @@ async def run_demo(
             elif nav.get_feedback() is not None:  # stopped on the way: the waypoints before the current one
                 current = int(nav.get_feedback().current_waypoint)
                 summary.waypoints_reached = current - sum(1 for m in summary.missed if m < current)
-            summary.collisions = sim.body.collisions
-            summary.recoveries = server.recoveries
-            summary.sim_sec = sim.time_ns / 1e9
+            sim_stats = sim.statistics()
+            summary.collisions = sim_stats.collisions
+            summary.recoveries = server.statistics().recoveries
+            summary.sim_sec = sim_stats.sim_sec
             wall = time.perf_counter() - wall0
             if graph.aruco is not None:
                 stats = graph.aruco.pipeline.statistics()
@@ -474,4 +475,5 @@ def _progress_line(now: float, nav: Any, monitor: _Monitor, waypoints: list[Any]
         jitter = "n/a (lock-step)"
     fps_text = f"{fps:4.1f}" if math.isfinite(fps) else "  - "
     return (f"sim {now:6.1f} s  waypoint {wp}/{len(waypoints)}  {left:5.1f} m left  loc. error {err * 100:5.1f} cm  "
-            f"jitter {jitter}  perception {fps_text} fps  recoveries {server.recoveries}  collisions {sim.body.collisions}")
+            f"jitter {jitter}  perception {fps_text} fps  recoveries {server.statistics().recoveries}  "
+            f"collisions {sim.statistics().collisions}")

@@ -17,26 +17,44 @@ from ._costmap import (
     inflation_cost,
 )
 from ._maps import MapError, OccupancyMap, load_map, save_map
-from ._planner import Plan, PlanError, plan
+from ._planner import Plan, PlanError, PlanFailure, plan
 from ._amcl_node import AmclNode
 from ._geometry import pose_stamped
+from ._landmark_map import (
+    LANDMARK_MAP_SUFFIX,
+    LandmarkMap,
+    LandmarkMapError,
+    MarkerPlace,
+    landmark_map_path,
+    load_landmark_map,
+    save_landmark_map,
+)
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
 from ._map_server import MapServer
 from ._mapping import MappingNode, OccupancyMapper
-from ._navigation_server import NavigationServer
+from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
 __all__ = [
     "AmclNode",
     "LandmarkFixNode",
+    "LANDMARK_MAP_SUFFIX",
+    "LandmarkMap",
+    "LandmarkMapError",
+    "MarkerPlace",
+    "landmark_map_path",
+    "load_landmark_map",
+    "save_landmark_map",
     "base_pose_from_marker",
     "base_pose_from_markers",
     "map_from_marker",
     "MapServer",
     "MappingNode",
     "OccupancyMapper",
+    "NavigationFailure",
     "NavigationServer",
+    "NavigationStatistics",
     "Navigator",
     "TaskResult",
     "pose_stamped",
@@ -51,6 +69,7 @@ __all__ = [
     "Costmap",
     "Plan",
     "PlanError",
+    "PlanFailure",
     "RegulatedPurePursuit",
     "RppCommand",
     "RppParameters",

@@ -110,8 +110,9 @@ def base_pose_from_markers(
 class LandmarkFixNode(Node):
     """``/detections/markers`` (aiorobot_msgs/MarkerDetectionArray) -> ``/landmark_pose``.
 
-    Parameters: ``world`` (built-in world name or map YAML whose ``landmarks`` say where each
-    marker id is), ``markers_topic`` (/detections/markers), ``pose_topic`` (/landmark_pose),
+    Parameters: ``landmark_map`` (the landmark map file saying where each marker id is, see
+    :func:`~aiorobot.nav.load_landmark_map`; a simulator world's is beside its map YAML,
+    :func:`~aiorobot.nav.landmark_map_path`), ``markers_topic`` (/detections/markers), ``pose_topic`` (/landmark_pose),
     ``map_frame`` (map), ``base_frame`` (base_link), ``max_range_m`` (4.0: farther markers are
     ignored), ``position_std_m`` (0.03 at 1 m, growing with the square of the range) and
     ``yaw_std_rad`` (0.05: the heading's uncertainty, whose effect on position grows with the
@@ -130,20 +131,29 @@ class LandmarkFixNode(Node):
         super().__init__(node_name, **kwargs)
         from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
         from aiorobot.perception import MarkerDetectionArray
-        from aiorobot.sim import World
         from aiorobot.tf import Buffer, TransformListener
 
+        from ._landmark_map import load_landmark_map
+
         d = self.declare_parameter
-        world = World.load(str(d("world", "box", read_only=True).value))
+        path = str(d("landmark_map", "", read_only=True).value)
+        if not path:
+            raise ValueError("parameter landmark_map: expected the path of a landmark map file "
+                             "(such as a simulator world's <map>.landmarks.yaml), found ''")
+        #: where the markers are (a :class:`~aiorobot.nav.LandmarkMap`)
+        self.landmark_map = load_landmark_map(path)
         markers_topic = str(d("markers_topic", "/detections/markers", read_only=True).value)
         pose_topic = str(d("pose_topic", "/landmark_pose", read_only=True).value)
         self.map_frame = str(d("map_frame", "map").value)
         self.base_frame = str(d("base_frame", "base_link").value)
+        if self.landmark_map.frame_id != self.map_frame:
+            raise ValueError(f"{path}: frame_id: expected the map frame {self.map_frame!r} (parameter map_frame), "
+                             f"found {self.landmark_map.frame_id!r}")
         self.max_range_m = float(d("max_range_m", 4.0).value)
         self.position_std_m = float(d("position_std_m", 0.03).value)
         self.yaw_std_rad = float(d("yaw_std_rad", 0.05).value)
         self.min_baseline_m = float(d("min_baseline_m", 1.0).value)
-        self.landmarks = {lm.id: map_from_marker(lm.x, lm.y, lm.z, lm.yaw) for lm in world.landmarks}
+        self.landmarks = {i: m.map_from_marker() for i, m in self.landmark_map.markers.items()}
         self.fixes = 0
         self.heading_fixes = 0
         self.ignored = 0

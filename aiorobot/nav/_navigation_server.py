@@ -22,9 +22,10 @@ message on the topic (a graph without that estimator) means no check.
 
 from __future__ import annotations
 
+import enum
 import math
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -36,10 +37,53 @@ from ._costmap import Costmap
 from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
-from ._planner import Plan, PlanError, plan
+from ._planner import Plan, PlanError, PlanFailure, plan
 from ._rpp import RegulatedPurePursuit, RppParameters
 
-__all__ = ["NavigationServer"]
+__all__ = ["NavigationFailure", "NavigationServer", "NavigationStatistics"]
+
+
+class NavigationFailure(enum.Enum):
+    """Why a goal aborted, besides the planner's :class:`~aiorobot.nav.PlanFailure`.
+
+    Each name is a code of nav2_msgs ``NavigateToPose.Result`` (``UNKNOWN``, ``TF_ERROR``); the
+    value is the code. The Jazzy interface shipped in :mod:`aiorobot.msgs` names only ``NONE``;
+    Nav2's newer NavigateToPose.action names UNKNOWN=9000, FAILED_TO_LOAD_BEHAVIOR_TREE=9001 and
+    TF_ERROR=9002, the numbers its bt_navigator returns, so those are the values, and :attr:`code`
+    takes the interface's constant wherever it defines one.
+    """
+
+    UNKNOWN = 9000
+    TF_ERROR = 9002
+
+    @property
+    def code(self) -> int:
+        from aiorobot.msgs.nav2_msgs import NavigateToPose
+
+        return int(getattr(NavigateToPose.Result, self.name, self.value))
+
+
+def _plan_code(kind: PlanFailure) -> int:
+    """The nav2_msgs ComputePathToPose.Result error code for a planner failure (Nav2's planner server's)."""
+    from aiorobot.msgs.nav2_msgs import ComputePathToPose
+
+    return int(getattr(ComputePathToPose.Result, kind.name))
+
+
+#: planner failures no recovery helps with: the goal or the start is off the map, or the goal is occupied
+_HOPELESS = (PlanFailure.START_OUTSIDE_MAP, PlanFailure.GOAL_OUTSIDE_MAP, PlanFailure.GOAL_OCCUPIED)
+
+
+@dataclass(frozen=True, slots=True)
+class NavigationStatistics:
+    """What :meth:`NavigationServer.statistics` reports (a snapshot)."""
+
+    #: recoveries run for the current goal (or the last one), as the feedback's number_of_recoveries
+    recoveries: int
+    #: a navigation goal is being executed
+    navigating: bool
+    #: why the latest pose estimate counts as lost; None when fine or none seen
+    localization_lost: str | None
 
 
 def _accept_cancel(_handle: Any) -> Any:
@@ -49,9 +93,12 @@ def _accept_cancel(_handle: Any) -> Any:
 
 
 class _Abort(Exception):
-    def __init__(self, code: int, message: str) -> None:
+    """A goal ends aborted: ``kind`` says why, ``code`` is its nav2_msgs result code."""
+
+    def __init__(self, kind: NavigationFailure | PlanFailure, message: str) -> None:
         super().__init__(message)
-        self.code = code
+        self.kind = kind
+        self.code = _plan_code(kind) if isinstance(kind, PlanFailure) else kind.code
 
 
 class NavigationServer(Node):
@@ -116,6 +163,10 @@ class NavigationServer(Node):
         self.create_action_server(ComputePathToPose, "compute_path_to_pose", self._compute_path, cancel_callback=_accept_cancel)
         self.last_plan: Plan | None = None
         self.recoveries = 0
+
+    def statistics(self) -> NavigationStatistics:
+        """Recoveries of the current or last goal, whether one is running, the localisation state."""
+        return NavigationStatistics(self.recoveries, self._busy, self.localization_lost)
 
     # -- inputs -------------------------------------------------------------------------
 
@@ -196,7 +247,8 @@ class NavigationServer(Node):
         result = action.Result()
         if not poses:
             handle.abort()
-            result.error_code, result.error_msg = 9000, "no poses to navigate to: the goal's pose list is empty"
+            result.error_code = NavigationFailure.UNKNOWN.code
+            result.error_msg = "no poses to navigate to: the goal's pose list is empty"
             return result
         self._busy = True
         self.recoveries = 0
@@ -280,7 +332,7 @@ class NavigationServer(Node):
         waited = 0.0
         while self.costmap is None:
             if waited >= self.map_timeout:
-                raise _Abort(9000, f"no /map received within {self.map_timeout:g} s; start a map server or the simulator")
+                raise _Abort(NavigationFailure.UNKNOWN, f"no /map received within {self.map_timeout:g} s; start a map server or the simulator")
             await clock.sleep_for(0.1)
             waited += 0.1
 
@@ -304,16 +356,14 @@ class NavigationServer(Node):
         try:
             return transform_to_xyyaw(self.buffer.lookup_transform(self.global_frame, self.base_frame, Time()))
         except TransformException as err:
-            raise _Abort(9002, f"no transform {self.global_frame} -> {self.base_frame}: {err}") from None
+            raise _Abort(NavigationFailure.TF_ERROR, f"no transform {self.global_frame} -> {self.base_frame}: {err}") from None
 
     def _plan(self, start: tuple[float, float, float], goal: tuple[float, float, float]) -> Plan:
         assert self.costmap is not None
         try:
             p = plan(self.costmap, start[:2], goal[:2], goal_yaw=goal[2], allow_unknown=self.allow_unknown)
         except PlanError as err:
-            text = str(err)
-            code = 204 if "goal" in text and "outside" in text else 203 if "outside" in text else 206 if "obstacle" in text else 208
-            raise _Abort(code, text) from None
+            raise _Abort(err.kind, str(err)) from None
         self.last_plan = p
         self.plan_pub.publish(self._path_msg(p))
         return p
@@ -335,7 +385,7 @@ class NavigationServer(Node):
         await self._wait_for_map()
         await self._wait_for_robot_pose()
         if self.localization_lost is not None:
-            raise _Abort(9000, f"localisation lost: {self.localization_lost}; not driving")
+            raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost}; not driving")
         goal = xyyaw(target)
         rpp = RegulatedPurePursuit(self.rpp_params, self.costmap)
         clock = self.get_clock()
@@ -358,8 +408,8 @@ class NavigationServer(Node):
                     self.get_logger().warning(f"localisation lost ({self.localization_lost}): stopped; waiting up to "
                                               f"{self.localization_recovery_timeout:g} s for it to come back")
                 if t - lost_since >= self.localization_recovery_timeout:
-                    raise _Abort(9000, f"localisation lost: {self.localization_lost} for "
-                                       f"{self.localization_recovery_timeout:g} s")
+                    raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost} for "
+                                                            f"{self.localization_recovery_timeout:g} s")
                 await clock.sleep_for(period)
                 t += period
                 progress_ref = (progress_ref[0], t)  # standing still for this is not a lack of progress
@@ -372,7 +422,7 @@ class NavigationServer(Node):
                 try:
                     rpp.set_plan(self._plan(pose, goal).poses)
                 except _Abort as err:
-                    if first_plan and err.code in (203, 204, 206):
+                    if first_plan and err.kind in _HOPELESS:
                         raise  # outside the map / occupied: no recovery helps
                     await self._recover(handle, f"no path ({err})")
                     progress_ref = (self._robot_pose(), t)
@@ -418,7 +468,7 @@ class NavigationServer(Node):
     async def _recover(self, handle: Any, why: str) -> None:
         """Nav2's recoveries in turn: clear + wait, back up, spin; abort when the budget is spent."""
         if self.recoveries >= self.max_recoveries:
-            raise _Abort(9000, f"blocked ({why}) and {self.max_recoveries} recoveries did not help")
+            raise _Abort(NavigationFailure.UNKNOWN, f"blocked ({why}) and {self.max_recoveries} recoveries did not help")
         kind = ("clear_and_wait", "backup", "spin")[self.recoveries % 3]
         self.recoveries += 1
         self.get_logger().info(f"recovery {self.recoveries}/{self.max_recoveries}: {kind} ({why})")

@@ -8,6 +8,7 @@ last takes the goal's yaw when given).
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass
 
@@ -16,11 +17,28 @@ from numpy.typing import NDArray
 
 from ._costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION, Costmap
 
-__all__ = ["PlanError", "Plan", "plan"]
+__all__ = ["PlanError", "PlanFailure", "Plan", "plan"]
+
+
+class PlanFailure(enum.Enum):
+    """Why :func:`plan` found no path. Each name is the nav2_msgs ``ComputePathToPose.Result``
+    error code that says it (``getattr(ComputePathToPose.Result, kind.name)``)."""
+
+    START_OUTSIDE_MAP = "the start is outside the map"
+    GOAL_OUTSIDE_MAP = "the goal is outside the map"
+    GOAL_OCCUPIED = "the goal is in or too close to an obstacle"
+    NO_VALID_PATH = "no path joins the start to the goal"
 
 
 class PlanError(Exception):
-    """No path: the start or goal is outside the map or in an obstacle, or the goal is unreachable."""
+    """No path: the start or goal is outside the map or in an obstacle, or the goal is unreachable.
+
+    ``kind`` (a :class:`PlanFailure`) says which, for code; the message says it for people.
+    """
+
+    def __init__(self, message: str, kind: PlanFailure = PlanFailure.NO_VALID_PATH) -> None:
+        super().__init__(message)
+        self.kind = kind
 
 
 @dataclass(frozen=True)
@@ -45,16 +63,19 @@ def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, 
     gr, gc = costmap.world_to_cell(*goal_xy)
     for what, (r, c), xy in (("start", (sr, sc), start_xy), ("goal", (gr, gc), goal_xy)):
         if not costmap.in_bounds(r, c):
-            raise PlanError(f"the {what} ({xy[0]:.2f}, {xy[1]:.2f}) is outside the map")
+            kind = PlanFailure.START_OUTSIDE_MAP if what == "start" else PlanFailure.GOAL_OUTSIDE_MAP
+            raise PlanError(f"the {what} ({xy[0]:.2f}, {xy[1]:.2f}) is outside the map", kind)
     if _blocked(int(costmap.cost[gr, gc]), allow_unknown):
-        raise PlanError(f"the goal ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}) is in or too close to an obstacle (cost {int(costmap.cost[gr, gc])})")
+        raise PlanError(f"the goal ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}) is in or too close to an obstacle (cost {int(costmap.cost[gr, gc])})",
+                        PlanFailure.GOAL_OCCUPIED)
     cost = costmap.cost
     if _blocked(int(cost[sr, sc]), allow_unknown):  # a start inside inflation: plan out of it as Nav2 planners do
         cost = cost.copy()
         cost[sr, sc] = INSCRIBED_INFLATED_OBSTACLE - 1
     cells, total = astar(cost, sr, sc, gr, gc, float(neutral_cost), float(cost_factor), bool(allow_unknown))
     if cells.shape[0] == 0:
-        raise PlanError(f"no path from ({start_xy[0]:.2f}, {start_xy[1]:.2f}) to ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}): the goal is unreachable")
+        raise PlanError(f"no path from ({start_xy[0]:.2f}, {start_xy[1]:.2f}) to ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}): the goal is unreachable",
+                        PlanFailure.NO_VALID_PATH)
     if smooth and cells.shape[0] > 2:
         cells = shortcut(cost, cells)
     # cell centres, as Costmap.cell_to_world, for the whole path at once

@@ -17,9 +17,9 @@ from ._raycast import clearance_map, raycast
 from ._robot import RobotBody, make_kinematics
 from ._sensors import GRAVITY, ImuModel, LidarModel
 from ._start import StartChoice, nearest_free_spot, parse_start, resolve_start
-from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TIME_SOURCES, TOPICS, Simulator
+from ._simulator import CAMERA_XYZ, FRAMES, IMU_XYZ, LASER_XYZ, TIME_SOURCES, TOPICS, Simulator, SimulatorStatistics
 from ._world import BUILTIN_WORLDS, Landmark, World, WorldError, builtin_world_path
-from ._world_file import load_world, save_world
+from ._world_file import export_landmark_map, load_world, save_world
 
 __all__ = [
     "BUILTIN_WORLDS",
@@ -37,6 +37,7 @@ __all__ = [
     "OPTICAL_FROM_LINK",
     "RobotBody",
     "Simulator",
+    "SimulatorStatistics",
     "StartChoice",
     "TIME_SOURCES",
     "TOPICS",
@@ -45,6 +46,7 @@ __all__ = [
     "builtin_world_path",
     "camera_pose_matrix",
     "clearance_map",
+    "export_landmark_map",
     "load_world",
     "make_box",
     "make_kinematics",

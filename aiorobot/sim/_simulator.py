@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,7 @@ from ._sensors import ImuModel, LidarModel
 from ._start import resolve_start
 from ._world import World
 
-__all__ = ["CAMERA_XYZ", "FRAMES", "IMU_XYZ", "LASER_XYZ", "TIME_SOURCES", "TOPICS", "Simulator"]
+__all__ = ["CAMERA_XYZ", "FRAMES", "IMU_XYZ", "LASER_XYZ", "TIME_SOURCES", "TOPICS", "Simulator", "SimulatorStatistics"]
 
 _NS = 1_000_000_000
 #: ``sim``: the simulator owns time (``/clock`` from zero); ``system``: stamps are system time.
@@ -70,6 +71,29 @@ TOPICS = {
     "/tf_static": ("tf2_msgs/msg/TFMessage", "base_link -> laser, imu_link, camera_link -> camera_optical_frame"),
     "/tf": ("tf2_msgs/msg/TFMessage", "odom -> base_link when publish_odom_tf is set"),
 }
+
+
+@dataclass(frozen=True, slots=True)
+class SimulatorStatistics:
+    """What :meth:`Simulator.statistics` reports: a snapshot, safe to keep and compare."""
+
+    #: the simulator's elapsed time (ns from its start, on either time source)
+    sim_time_ns: int
+    #: world steps taken
+    steps: int
+    #: wall seconds its loop has run
+    wall_elapsed_sec: float
+    #: times the robot's disc met an obstacle (counted once per contact)
+    collisions: int
+    #: ground-truth distance the robot drove (m)
+    distance_m: float
+    #: velocity commands taken, and those refused (not finite)
+    commands_received: int
+    commands_ignored: int
+
+    @property
+    def sim_sec(self) -> float:
+        return self.sim_time_ns / _NS
 
 
 class _Stream:
@@ -513,6 +537,12 @@ class Simulator(Node):
         self.image_pub.publish(msg)
 
     # -- aiorobot run / sim display -------------------------------------------------------
+
+    def statistics(self) -> SimulatorStatistics:
+        """Sim time, steps, collisions and distance so far (a frozen snapshot)."""
+        body = self.body
+        return SimulatorStatistics(self.time_ns, self.steps, self.wall_elapsed_sec, body.collisions, body.distance_m,
+                                   self.commands_received, self.commands_ignored)
 
     @property
     def achieved_real_time_factor(self) -> float:

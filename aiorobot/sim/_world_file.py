@@ -11,7 +11,7 @@ import numpy as np
 
 from ._world import Landmark, World, WorldError, _landmark_dict
 
-__all__ = ["load_world", "save_world"]
+__all__ = ["export_landmark_map", "load_world", "save_world"]
 
 _MODES = ("trinary",)
 
@@ -162,7 +162,8 @@ def _read_image(yaml_path: Path, image_path: Path, occupied_thresh: float, free_
 
 
 def save_world(world: World, yaml_path: str | os.PathLike[str]) -> Path:
-    """Write ``world`` as ``<name>.yaml`` + ``<name>.pgm`` (map_server format plus landmarks)."""
+    """Write ``world`` as ``<name>.yaml`` + ``<name>.pgm`` (map_server format plus landmarks) and
+    navigation's landmark map beside them, ``<name>.landmarks.yaml`` (:func:`export_landmark_map`)."""
     import cv2
     import yaml
 
@@ -182,4 +183,14 @@ def save_world(world: World, yaml_path: str | os.PathLike[str]) -> Path:
         "landmarks": [_landmark_dict(lm) for lm in world.landmarks],
     }
     yaml_path.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None), encoding="utf-8")
+    export_landmark_map(world, yaml_path)
     return yaml_path
+
+
+def export_landmark_map(world: World, map_yaml: str | os.PathLike[str]) -> Path:
+    """Write the world's landmarks as navigation's landmark map beside ``map_yaml``
+    (:func:`aiorobot.nav.landmark_map_path`; the format is :mod:`aiorobot.nav`'s, which never reads a world)."""
+    from aiorobot.nav import MarkerPlace, landmark_map_path, save_landmark_map
+
+    places = [MarkerPlace(lm.id, lm.size, lm.x, lm.y, lm.z, lm.yaw, lm.dictionary) for lm in world.landmarks]
+    return save_landmark_map(places, landmark_map_path(map_yaml))

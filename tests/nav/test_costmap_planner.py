@@ -195,3 +195,31 @@ def test_obstacle_layer_marks_hits_and_clears_along_beams() -> None:
     assert cm.obstacles[10, 30] == LETHAL_OBSTACLE  # the hit at x=1.5
     assert cm.obstacles[10, 20] == 0  # cleared by the beam passing through it
     assert cm.cost_at(1.5, 0.525) == LETHAL_OBSTACLE
+
+
+def test_each_planner_failure_has_its_kind_and_nav2s_named_result_code() -> None:
+    from aiorobot.msgs.nav2_msgs import ComputePathToPose
+    from aiorobot.nav import PlanFailure
+
+    static = np.zeros((40, 40), dtype=np.uint8)
+    static[:, 20] = LETHAL_OBSTACLE  # a wall across the whole map
+    cm = Costmap(static, 0.05, (0.0, 0.0))
+    cases = {
+        PlanFailure.START_OUTSIDE_MAP: ((-1.0, 0.5), (0.5, 0.5)),
+        PlanFailure.GOAL_OUTSIDE_MAP: ((0.5, 0.5), (0.5, 9.0)),
+        PlanFailure.GOAL_OCCUPIED: ((0.5, 0.5), (1.02, 0.5)),
+        PlanFailure.NO_VALID_PATH: ((0.5, 0.5), (1.6, 0.5)),
+    }
+    for kind, (start, goal) in cases.items():
+        with pytest.raises(PlanError) as err:
+            plan(cm, start, goal)
+        assert err.value.kind is kind, str(err.value)
+    codes = {kind: getattr(ComputePathToPose.Result, kind.name) for kind in PlanFailure}
+    assert codes == {PlanFailure.START_OUTSIDE_MAP: 203, PlanFailure.GOAL_OUTSIDE_MAP: 204,
+                     PlanFailure.GOAL_OCCUPIED: 206, PlanFailure.NO_VALID_PATH: 208}
+
+
+def test_navigation_failures_carry_nav2s_navigate_to_pose_codes() -> None:
+    from aiorobot.nav import NavigationFailure
+
+    assert {k.name: k.code for k in NavigationFailure} == {"UNKNOWN": 9000, "TF_ERROR": 9002}

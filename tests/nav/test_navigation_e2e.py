@@ -89,6 +89,8 @@ async def test_navigate_to_pose_goes_around_the_wall_and_succeeds(world) -> None
     assert max(p for p in [server.costmap.cost_at(*xy) for xy in server.last_plan.poses[:, :2]]) < 253
     fb = nav.get_feedback()
     assert fb is not None and fb.navigation_time.sec > 0
+    stats = server.statistics()
+    assert (stats.navigating, stats.localization_lost, stats.recoveries) == (False, None, fb.number_of_recoveries)
 
 
 async def test_a_goal_inside_the_wall_fails_with_nav2s_code_and_a_reason(world) -> None:

@@ -218,3 +218,20 @@ def test_example_config_builds() -> None:
     nodes = build_nodes(config)
     assert [type(n).__name__ for n, _ in nodes] == ["Simulator"]
     assert config.runtime.use_sim_time
+
+
+async def test_statistics_report_sim_time_collisions_and_commands_as_a_frozen_snapshot() -> None:
+    import dataclasses
+
+    from aiorobot.sim import SimulatorStatistics
+
+    async with Runtime(use_sim_time=True, handle_signals=False) as rt:
+        sim = rt.add_node(Simulator(parameter_overrides={"world": "box", "real_time_factor": 0.0, "duration_sec": 0.5,
+                                                         "camera_rate": 0.0}))
+        await rt.spin(duration_sec=60.0)
+    stats = sim.statistics()
+    assert isinstance(stats, SimulatorStatistics)
+    assert stats.sim_time_ns == 500_000_000 and stats.sim_sec == 0.5 and stats.steps == sim.steps > 0
+    assert (stats.collisions, stats.distance_m, stats.commands_received) == (0, 0.0, 0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        stats.collisions = 1  # type: ignore[misc]
