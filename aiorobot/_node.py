@@ -470,10 +470,12 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
     @property
     def services(self) -> tuple[Service, ...]:
+        """This node's services, as rclpy's ``Node.services``."""
         return tuple(self._services)
 
     @property
     def clients(self) -> tuple[Client, ...]:
+        """This node's service clients, as rclpy's ``Node.clients``."""
         return tuple(self._clients)
 
     @property
