@@ -30,12 +30,8 @@ import threading
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from ._groups import CallbackGroup
-from ._node import Node
-from ._pubsub import Endpoint, Publisher, Tap
-from ._qos import QoSProfile
-from ._runtime import Runtime
-from ._services import Client
+from . import CallbackGroup, Client, Node, Publisher, QoSProfile, Runtime
+from ._pubsub import Endpoint, Tap
 
 __all__ = [
     "ON_FAILURE",

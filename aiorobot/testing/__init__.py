@@ -17,7 +17,7 @@ test, shut down after it), ``sim_runtime`` (the same with ``use_sim_time``) and
 
 from __future__ import annotations
 
-from .._runtime import Runtime
+from .. import Runtime
 from ..lowlevel import wait_for_message
 from ._sim import ClockPublisher, SimClock
 

@@ -140,9 +140,7 @@ async def test_on_added_runs_before_the_nodes_endpoints_join_and_a_failure_leave
 
 
 async def test_add_client_makes_an_extensions_client_the_nodes_own():
-    from aiorobot._services import Client
-
-    class LoudClient(Client):
+    class LoudClient(aiorobot.Client):
         pass
 
     async with Runtime(handle_signals=False) as rt:
