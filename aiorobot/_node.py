@@ -161,6 +161,12 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     async def on_start(self) -> None:
         """Called on the node's loop once it runs (open devices, start background work)."""
 
+    def on_added(self) -> None:
+        """Called synchronously by ``Runtime.add_node`` once the node belongs to the runtime,
+        before its endpoints join the graph and before anything else is added: for extensions
+        that must see the graph from its start (a recorder taps publishers added right after it).
+        What it raises leaves the node out of the runtime and propagates from ``add_node``."""
+
     async def on_shutdown(self) -> None:
         """Called once when the runtime shuts down, before anything stops.
 
@@ -462,6 +468,21 @@ class Node(NodeParametersMixin, NodeGraphMixin):
     def timers(self) -> tuple[Timer, ...]:
         return tuple(self._timers)
 
+    @property
+    def services(self) -> tuple[Service, ...]:
+        """This node's services, as rclpy's ``Node.services``."""
+        return tuple(self._services)
+
+    @property
+    def clients(self) -> tuple[Client, ...]:
+        """This node's service clients, as rclpy's ``Node.clients``."""
+        return tuple(self._clients)
+
+    @property
+    def default_callback_group(self) -> CallbackGroup:
+        """The group of entities created without one (mutually exclusive), as rclpy's."""
+        return self._default_group
+
     # -- logging and time -----------------------------------------------------------------
 
     def get_logger(self) -> NodeLogger:
@@ -545,12 +566,22 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         elif not loop.is_closed():
             loop.call_soon_threadsafe(fn, *args)
 
-    def _create_task(self, coro: Awaitable[Any], *, name: str | None = None) -> asyncio.Task[Any]:
-        assert self._loop is not None
+    def create_task(self, coro: Awaitable[Any], *, name: str | None = None) -> asyncio.Task[Any]:
+        """Run ``coro`` as a task of this node, on its loop (call it from that loop).
+
+        Unlike ``asyncio.create_task``, the node keeps the task: removing the node or shutting
+        the runtime down cancels it and waits for it. ``RuntimeError`` before the node is added.
+        """
+        if self._loop is None:
+            if inspect.iscoroutine(coro):
+                coro.close()
+            raise RuntimeError(f"create_task: {self!r} is not added to a runtime; call runtime.add_node(node) first")
         task: asyncio.Task[Any] = self._loop.create_task(coro, name=name)  # type: ignore[arg-type]
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
         return task
+
+    _create_task = create_task  # the core's entities call it by this name
 
     def _start(self) -> None:
         """Start dispatchers and timers (on the node's loop), then ``on_start``."""

@@ -278,6 +278,7 @@ class Runtime:
         added: list[Any] = []
         self.transport.node_added(node)
         try:
+            node.on_added()
             for pub in node._publishers:
                 self._bus.add_publisher(pub)
                 added.append(pub)
@@ -407,13 +408,6 @@ class Runtime:
         )
         self.shutdown()
 
-    def _add_emergency_stop(self, owner: str, fn: Any) -> None:
-        """Call ``fn()`` from the watchdog thread (no callback can block it) on SIGINT/SIGTERM."""
-        self._watchdog.add_emergency_stop(owner, fn)
-
-    def _remove_emergency_stop(self, fn: Any) -> None:
-        self._watchdog.remove_emergency_stop(fn)
-
     def _record_failure(self, node: str, entity: str) -> tuple[int, bool]:
         """Count one failure of ``entity`` in ``node``: (how many so far, whether to log it now)."""
         from ._node import FAILURE_LOG_PERIOD_SEC
@@ -447,6 +441,26 @@ class Runtime:
             "failures": dict(self._failures),
             "failed_starts": list(self._failed_starts),
         }
+
+    async def settle(self, *, rounds: int = 3, max_rounds: int = 1000) -> None:
+        """Run the main and priority loops until every subscription and service queue is handled.
+
+        Waits for ``rounds`` consecutive quiet passes (a pass yields to the main loop and makes
+        a round trip through the priority loop), at most ``max_rounds`` passes. Callbacks
+        waiting on I/O or on time may still be pending afterwards: wait for their effects.
+        """
+        quiet = 0
+        for _ in range(max_rounds):
+            await asyncio.sleep(0)
+            prio = self._priority
+            if prio is not None and prio.loop is not None:
+                await prio.run(asyncio.sleep(0))
+            if all(node._idle() for node in self._nodes):
+                quiet += 1
+                if quiet >= rounds:
+                    return
+            else:
+                quiet = 0
 
     def shutdown(self) -> None:
         """Ask ``spin`` to return (from any thread). ``async with`` then stops everything."""

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aiorobot import Node
+from aiorobot.lowlevel import add_emergency_stop, remove_emergency_stop
 
 from ._kinematics import DiffDrive, Kinematics, Mecanum, saturate_wheel_speeds
 from ._odometry import WheelOdometry
@@ -215,7 +216,7 @@ class BaseController(Node):
         self.wheel_pub.publish(msg)
 
     async def on_start(self) -> None:
-        self.runtime._add_emergency_stop(self.get_fully_qualified_name(), self._emergency_stop)
+        add_emergency_stop(self.runtime, self.get_fully_qualified_name(), self._emergency_stop)
 
     def _emergency_stop(self) -> None:
         """On SIGINT/SIGTERM, before anything else: publish zero wheel speeds.
@@ -227,7 +228,7 @@ class BaseController(Node):
         self._publish_wheels(np.zeros(self.kinematics.n_wheels))
 
     async def on_shutdown(self) -> None:
-        self.runtime._remove_emergency_stop(self._emergency_stop)
+        remove_emergency_stop(self.runtime, self._emergency_stop)
         self.target = np.zeros(3)
         self.smoother.reset()
         self.wheel_command = np.zeros(self.kinematics.n_wheels)

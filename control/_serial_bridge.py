@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aiorobot import Node, Time
+from aiorobot.lowlevel import add_emergency_stop, remove_emergency_stop
 
 from ._framing import FrameError
 from ._messages import (
@@ -121,7 +122,7 @@ class SerialMotorBridge(Node):
     # -- lifecycle -----------------------------------------------------------------------
 
     async def on_start(self) -> None:
-        self.runtime._add_emergency_stop(self.get_fully_qualified_name(), self._emergency_stop)
+        add_emergency_stop(self.runtime, self.get_fully_qualified_name(), self._emergency_stop)
         self._try_connect(time.monotonic())
 
     def _emergency_stop(self) -> None:
@@ -141,7 +142,7 @@ class SerialMotorBridge(Node):
             self.get_logger().warning(f"emergency zero command to {self.port} not written: {err}")
 
     async def on_shutdown(self) -> None:
-        self.runtime._remove_emergency_stop(self._emergency_stop)
+        remove_emergency_stop(self.runtime, self._emergency_stop)
         self._shutting_down = True
         if self.link.connected:
             self.link.send(SetWheelVelocities((0.0,) * len(self.joint_names)))

@@ -178,7 +178,7 @@ class Pipeline:
             self._stop_all()
             raise
         # a node task: the node stopping (runtime shutdown, remove_node) cancels it, which cleans up
-        self._supervisor = self.node._create_task(self._supervise(), name=f"pipeline {self.topic}")
+        self._supervisor = self.node.create_task(self._supervise(), name=f"pipeline {self.topic}")
 
     def _spawn(self, index: int) -> _Worker:
         assert self._ring is not None and self._loop is not None

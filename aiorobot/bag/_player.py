@@ -20,6 +20,7 @@ from typing import Any
 
 from .._node import Node
 from .._qos import QoSProfile, ReliabilityPolicy
+from ..lowlevel import wait_until_ns
 from ._metadata import BagError
 from ._reader import BagReader
 
@@ -206,7 +207,7 @@ class Player(Node):
     # -- playing -------------------------------------------------------------------------
 
     async def on_start(self) -> None:
-        self._task = self._create_task(self._play(), name=f"aiorobot-player {self.path}")
+        self._task = self.create_task(self._play(), name=f"aiorobot-player {self.path}")
 
     async def on_shutdown(self) -> None:
         if self._task is not None:
@@ -271,11 +272,7 @@ class Player(Node):
 
     async def _sleep_until_ns(self, deadline_ns: int) -> None:
         """Sleep to a monotonic deadline with the loop's precise waker (libuv timers are whole ms)."""
-        waker = self._waker
-        if waker is not None:
-            await waker.wait_until_ns(deadline_ns)
-        else:  # pragma: no cover - a player always runs bound to a runtime
-            await asyncio.sleep(max(0.0, (deadline_ns - time.monotonic_ns()) / 1e9))
+        await wait_until_ns(self, deadline_ns)
 
     def _publish_clock(self, t_ns: int) -> None:
         from aiorobot.msgs.builtin_interfaces import Time as TimeMsg

@@ -20,8 +20,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._node import Node
-from .._pubsub import Endpoint, Publisher, Tap
+from .._pubsub import Endpoint, Publisher
 from .._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ..lowlevel import Tap, add_tap, remove_tap, watch_publishers
 from ._metadata import BagError
 from ._writer import CHUNK_SIZE, BagWriter
 
@@ -114,10 +115,9 @@ class Recorder(Node):
 
     # -- lifecycle --------------------------------------------------------------------
 
-    def _bind(self, runtime: Any, *args: Any, **kwargs: Any) -> None:
+    def on_added(self) -> None:
         # Attach when added to the runtime, synchronously, not in on_start: a publisher added
         # right after the recorder must not publish before the recorder taps it.
-        super()._bind(runtime, *args, **kwargs)
         if self._thread is None:
             self._attach()
 
@@ -131,12 +131,8 @@ class Recorder(Node):
         )
         self._thread = threading.Thread(target=self._write_loop, name=f"aiorobot-recorder {self.path}", daemon=True)
         self._thread.start()
-        bus = self.runtime._bus
         if self.all_topics:
-            self._unwatch = bus.watch(self._on_endpoint)
-            for topic in bus.snapshot():
-                for pub in topic.publishers:
-                    self._on_endpoint(pub)
+            self._unwatch = watch_publishers(self.runtime, self._on_endpoint)
         for name in self.topics:
             self._tap_requested(name)
         self.get_logger().info(
@@ -151,11 +147,11 @@ class Recorder(Node):
         if self._unwatch is not None:
             self._unwatch()
             self._unwatch = None
-        if self._runtime is not None:
+        if self.executor is not None:
             with self._lock:
                 taps, self._taps = list(self._taps.values()), {}
             for tap in taps:
-                self._runtime._bus.remove(tap)
+                remove_tap(self.runtime, tap)
         if self._thread is not None:
             self._queue.put(_STOP)
             self._thread.join()
@@ -175,20 +171,20 @@ class Recorder(Node):
     def _tap_requested(self, name: str) -> None:
         """Tap ``name`` now if it has a publisher, else as soon as one appears."""
         name = self.resolve_topic_name(name)
-        for topic in self.runtime._bus.snapshot():
-            if topic.name == name and topic.publishers:
-                pub = topic.publishers[0]
-                self._add_tap(name, pub.msg_type, pub.qos)
-                return
+        found = False
         unwatch = None
 
-        def later(endpoint: Endpoint) -> None:
-            if isinstance(endpoint, Publisher) and endpoint.topic_name == name:
-                self._add_tap(name, endpoint.msg_type, endpoint.qos)
+        def on_publisher(pub: Publisher[Any]) -> None:
+            nonlocal found
+            if pub.topic_name == name and not found:
+                found = True
+                self._add_tap(name, pub.msg_type, pub.qos)
                 if unwatch is not None:
                     unwatch()
 
-        unwatch = self.runtime._bus.watch(later)
+        unwatch = watch_publishers(self.runtime, on_publisher)
+        if found:
+            unwatch()
 
     def _add_tap(self, name: str, msg_type: Any, offered: QoSProfile) -> None:
         from aiorobot.msgs import serialize
@@ -211,7 +207,7 @@ class Recorder(Node):
             tap = Tap(msg_type, name, qos, record, owner=self.get_fully_qualified_name())
             tap.node, tap.wants_remote = self, True  # also receives remote publishers over a transport
             self._taps[name] = tap
-        self.runtime._bus.add_subscription(tap)
+        add_tap(self.runtime, tap)
         if durability is DurabilityPolicy.TRANSIENT_LOCAL:
             self.get_logger().debug(f"recording {name} (transient local)")
 

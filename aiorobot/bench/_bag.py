@@ -97,9 +97,8 @@ def _serialise_cost(duration: float, published: dict[str, int]) -> float:
 
 
 async def _play_spacing(quick: bool, tmp: Path) -> dict[str, Any]:
-    from aiorobot import Runtime
-    from aiorobot._pubsub import Tap
-    from aiorobot._qos import QoSProfile
+    from aiorobot import QoSProfile, Runtime
+    from aiorobot.lowlevel import Tap, add_tap
     from aiorobot.bag import BagWriter, Player
     from aiorobot.msgs import serialize
     from aiorobot.msgs.std_msgs import UInt32
@@ -113,7 +112,7 @@ async def _play_spacing(quick: bool, tmp: Path) -> dict[str, Any]:
     arrivals: list[float] = []
     async with Runtime(handle_signals=False) as rt:
         player = Player(path=str(bag))
-        rt._bus.add_subscription(Tap(UInt32, "/seq", QoSProfile(), lambda m: arrivals.append(time.perf_counter())))
+        add_tap(rt, Tap(UInt32, "/seq", QoSProfile(), lambda m: arrivals.append(time.perf_counter())))
         rt.add_node(player)
         await player.wait_for_completion(60)
     errors = [abs((b - a) * 1e3 - 1.0) * 1e3 for a, b in zip(arrivals, arrivals[1:])]  # us off 1 ms spacing

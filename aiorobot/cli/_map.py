@@ -39,7 +39,7 @@ async def _save(args: argparse.Namespace) -> int:
     from aiorobot.msgs.nav_msgs import OccupancyGrid
     from aiorobot.nav import OccupancyMap, save_map
     from aiorobot.nav._map_server import MAP_QOS
-    from aiorobot.testing import wait_for_message
+    from aiorobot.lowlevel import wait_for_message
 
     async with Runtime(transport=args.transport) as rt:
         node = rt.add_node(Node("map_saver"))

@@ -187,10 +187,11 @@ async def _serve_process(
 ) -> int:
     from aiorobot import Runtime
     from aiorobot._config import ConfigError
+    from aiorobot.lowlevel import set_on_failure
     from ._status import StatusDisplay
 
     for (node, _), node_config in zip(nodes, config.nodes):
-        node._on_failure = "continue" if keep_going and node_config.on_failure == "stop" else node_config.on_failure
+        set_on_failure(node, "continue" if keep_going and node_config.on_failure == "stop" else node_config.on_failure)
     runtime_config = config.runtime
     from aiorobot._transport import make_transport
 

@@ -26,6 +26,7 @@ from typing import Any, TypeVar
 
 from .._ros_args import RosArgs, parse_ros_args
 from .._runtime import Runtime
+from ..lowlevel import adopt_thread, stop_watching_stalls
 
 __all__ = ["Context", "ExternalShutdownException", "default_context", "settings"]
 
@@ -101,7 +102,7 @@ class Context:
                 runtime.add_node(_build_node(spec))
             # The loop only runs while a thread spins, and rclpy callbacks may block: the
             # stall watchdog would report every pause between spins, so it is off here.
-            runtime._watchdog.unwatch(loop)
+            stop_watching_stalls(runtime)
             self.loop, self.runtime = loop, runtime
             self._ok, self._closed = True, False
             self._install_signal_handlers()
@@ -405,14 +406,8 @@ class Context:
         """Make the calling thread the loop's: aiorobot checks thread ids to choose thread-safe paths."""
         tid = threading.get_ident()
         self._spin_thread = tid
-        runtime = self.runtime
-        if runtime is None or runtime._thread_id == tid:
-            return
-        runtime._thread_id = tid
-        for node in runtime._nodes:
-            node._thread_id = tid
-            for pub in node._publishers:
-                pub._thread_id = tid
+        if self.runtime is not None:
+            adopt_thread(self.runtime)
 
     def _request_shutdown(self) -> None:
         self._ok = False

@@ -15,6 +15,7 @@ from .._node import Node as _AioNode
 from .._event_handler import _EventCallbacks
 from .._qos import QoSProfile, to_qos_profile
 from .._timer import Rate as _AioRate
+from ..lowlevel import add_client, node_loop
 from ._context import Context, default_context
 from ._dispatch import gate_callback, wrap_callback
 from .rclpy.callback_groups import CallbackGroup, is_custom
@@ -60,7 +61,7 @@ class Client(_services.Client):
 
         self._check_request(request)
         ctx = self._context
-        fut = future_of(self._call_when_ready(request), None if _services._in_loop() else self.node._loop)
+        fut = future_of(self._call_when_ready(request), None if _services._in_loop() else node_loop(self.node))
         fut.add_done_callback(lambda _f: ctx.callback_finished())
         return fut
 
@@ -142,18 +143,6 @@ class NodeMixin:
     @property
     def context(self) -> Context:
         return self._context
-
-    @property
-    def default_callback_group(self) -> Any:
-        return self._default_group  # type: ignore[attr-defined]
-
-    @property
-    def clients(self) -> tuple[Any, ...]:
-        return tuple(self._clients)  # type: ignore[attr-defined]
-
-    @property
-    def services(self) -> tuple[Any, ...]:
-        return tuple(self._services)  # type: ignore[attr-defined]
 
     def _wrap(self, callback: Any, group: Any = None, *, coalesce: bool = False) -> tuple[Any, list[Any]]:
         """The callback as the executor runs it, and a one-slot list to put its entity in."""
@@ -286,13 +275,10 @@ class NodeMixin:
             return super().create_client(srv_type, srv_name, callback_group=callback_group)  # type: ignore[misc]
         client = Client(
             self, srv_type, self.resolve_topic_name(srv_name, kind="service"),  # type: ignore[attr-defined]
-            callback_group or self._default_group,  # type: ignore[attr-defined]
+            callback_group or self.default_callback_group,  # type: ignore[attr-defined]
         )
         client._context = self._context
-        self._clients.append(client)  # type: ignore[attr-defined]
-        if self._runtime is not None:  # type: ignore[attr-defined]
-            self._runtime._bus.services.add(client)  # type: ignore[attr-defined]
-        return client
+        return add_client(self, client)  # type: ignore[arg-type]
 
     @property
     def guards(self) -> tuple[Any, ...]:

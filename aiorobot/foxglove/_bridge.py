@@ -21,7 +21,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._node import Node
-from .._pubsub import Endpoint, Publisher, Tap
+from .._pubsub import Endpoint, Publisher
+from ..lowlevel import Tap, add_tap, node_loop, remove_tap, watch_publishers
 from .._qos import QoSProfile, ReliabilityPolicy
 
 __all__ = ["FoxgloveBridge", "FoxgloveStatistics"]
@@ -88,8 +89,8 @@ class FoxgloveBridge(Node):
 
     # -- lifecycle ----------------------------------------------------------------------
 
-    def _bind(self, runtime: Any, *args: Any, **kwargs: Any) -> None:
-        super()._bind(runtime, *args, **kwargs)  # attach at once: see Recorder._bind
+    def on_added(self) -> None:
+        # attach at once, as the Recorder does: a publisher added next must not publish unseen
         if self._server is None:
             self._attach()
 
@@ -112,11 +113,7 @@ class FoxgloveBridge(Node):
             raise OSError(f"foxglove bridge: cannot listen on {self.host}:{self.port} ({err})") from None
         self._thread = threading.Thread(target=self._send_loop, name="aiorobot-foxglove", daemon=True)
         self._thread.start()
-        bus = self.runtime._bus
-        self._unwatch = bus.watch(self._on_endpoint)
-        for topic in bus.snapshot():
-            for pub in topic.publishers:
-                self._on_endpoint(pub)
+        self._unwatch = watch_publishers(self.runtime, self._on_endpoint)
 
     async def on_start(self) -> None:
         self._refresh_services()
@@ -130,9 +127,9 @@ class FoxgloveBridge(Node):
         if self._unwatch is not None:
             self._unwatch()
             self._unwatch = None
-        if self._runtime is not None:
+        if self.executor is not None:
             for tap in self._taps:
-                self._runtime._bus.remove(tap)
+                remove_tap(self.runtime, tap)
         self._taps.clear()
         self._halt.set()
         self._wake.set()
@@ -191,7 +188,7 @@ class FoxgloveBridge(Node):
             tap = Tap(endpoint.msg_type, name, qos, forward, owner=self.get_fully_qualified_name())
             tap.node, tap.wants_remote = self, True  # also receives remote publishers over a transport
             self._taps.append(tap)
-        self.runtime._bus.add_subscription(tap)
+        add_tap(self.runtime, tap)
 
     def _send_loop(self) -> None:
         from aiorobot.msgs import serialize
@@ -213,7 +210,7 @@ class FoxgloveBridge(Node):
     # -- parameters and services ----------------------------------------------------------
 
     def _nodes(self) -> list[Node]:
-        return list(self.runtime.nodes) if self._runtime is not None else []
+        return list(self.runtime.nodes) if self.executor is not None else []
 
     def _get_parameters(self, names: list[str]) -> list[Any]:
         from foxglove.websocket import Parameter
@@ -239,7 +236,7 @@ class FoxgloveBridge(Node):
             if node is None:
                 continue
             value = _from_foxglove(p.get_value())
-            fut = asyncio.run_coroutine_threadsafe(_set(node, AParameter(pname, value)), node._loop)  # type: ignore[arg-type]
+            fut = asyncio.run_coroutine_threadsafe(_set(node, AParameter(pname, value)), node_loop(node))  # type: ignore[arg-type]
             try:
                 fut.result(timeout=5.0)
             except Exception as err:
@@ -299,7 +296,7 @@ class _ServiceHandler:
         from aiorobot.msgs import deserialize, serialize
 
         req = deserialize(bytes(request.payload), self.srv.Request)
-        loop = self.bridge._loop
+        loop = node_loop(self.bridge)
         assert loop is not None
 
         async def call() -> Any:

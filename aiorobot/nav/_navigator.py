@@ -86,7 +86,7 @@ class Navigator(Node):
         if not self._handle.accepted:
             self.get_logger().error("goal rejected")
             return False
-        self._result_task = self._create_task(self._wait_result())
+        self._result_task = self.create_task(self._wait_result())
         return True
 
     def _on_feedback(self, msg: Any) -> None:

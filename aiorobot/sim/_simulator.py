@@ -319,7 +319,7 @@ class Simulator(Node):
             self.pty.open()
             self.pty.attach()
             self.get_logger().info(f"simulated motor firmware on {self.pty.slave_path} (linked at {self.port_link})")
-        self._task = self._create_task(self._run(), name="simulator loop")
+        self._task = self.create_task(self._run(), name="simulator loop")
 
     async def on_shutdown(self) -> None:
         if self.pty is not None:
@@ -336,8 +336,6 @@ class Simulator(Node):
             self.runtime.shutdown()
 
     async def _loop_steps(self) -> None:
-        from aiorobot.testing import settle
-
         runtime = self.runtime
         loop = asyncio.get_running_loop()
         if self.time_source == "system":
@@ -348,7 +346,7 @@ class Simulator(Node):
         self.map_pub.publish(occupancy_grid_message(self.world, stamp, FRAMES["map"]))
         lockstep = self.real_time_factor == 0.0
         if lockstep:
-            await settle(runtime)
+            await runtime.settle()
         wall_start = loop.time()
         step_ns = round(self.step_sec * _NS)
         end_ns = round(self.duration_sec * _NS) if self.duration_sec > 0 else None
@@ -367,7 +365,7 @@ class Simulator(Node):
                 await asyncio.sleep(max(delay, 0.0))  # behind schedule: still let other tasks run
             self.step_to(target)
             if lockstep:
-                await settle(runtime)
+                await runtime.settle()
             self.wall_elapsed_sec = loop.time() - wall_start
             if end_ns is not None and self.time_ns >= end_ns:
                 runtime.shutdown()

@@ -10,12 +10,17 @@ test, shut down after it), ``sim_runtime`` (the same with ``use_sim_time``) and
         runtime.add_node(Talker())
         msg = await wait_for_message(probe, Twist, "/cmd_vel", timeout_sec=5)
         assert msg.linear.x == 0.0
+
+``settle`` is ``Runtime.settle`` (``await settle(runtime)``) and ``wait_for_message`` is
+``aiorobot.lowlevel.wait_for_message``: the core's, re-exported here for tests.
 """
 
 from __future__ import annotations
 
-from ._settle import settle
+from .. import Runtime
+from ..lowlevel import wait_for_message
 from ._sim import ClockPublisher, SimClock
-from ._wait import wait_for_message
+
+settle = Runtime.settle
 
 __all__ = ["ClockPublisher", "SimClock", "settle", "wait_for_message"]

@@ -5,7 +5,6 @@ from __future__ import annotations
 from .._clock_publisher import ClockPublisher
 from .._runtime import Runtime
 from .._time import Duration
-from ._settle import settle
 
 __all__ = ["ClockPublisher", "SimClock"]
 
@@ -40,7 +39,7 @@ class SimClock:
 
     async def set(self, seconds: float) -> None:
         self._node.publish_time(Duration(seconds=seconds).nanoseconds)
-        await settle(self.runtime)
+        await self.runtime.settle()
 
     async def advance(self, seconds: float, *, step_sec: float | None = None) -> None:
         step = self.step_ns if step_sec is None else Duration(seconds=step_sec).nanoseconds
@@ -51,4 +50,4 @@ class SimClock:
         while t < target:
             t = min(t + step, target)
             self._node.publish_time(t)
-            await settle(self.runtime)
+            await self.runtime.settle()

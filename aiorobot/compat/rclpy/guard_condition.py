@@ -15,6 +15,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..._groups import CallbackGroup
+from ...lowlevel import node_loop, run_callback
 from .._context import Context, default_context
 from .._dispatch import wrap_callback
 from .exceptions import InvalidHandle
@@ -69,7 +70,7 @@ class GuardCondition:
 
     def _ready(self) -> None:
         node = self._node
-        if node is None or self._destroyed or node._loop is None:
+        if node is None or self._destroyed or node_loop(node) is None:
             return  # on no executor: the trigger stays set, as an unwaited rcl guard condition's
         with self._lock:
             self._triggered = False
@@ -77,4 +78,4 @@ class GuardCondition:
             self._context.callback_finished()
             return
         callback = wrap_callback(self._context, self.callback)
-        node._create_task(node._invoke(self, self.callback_group, callback), name=f"guard condition of {node.get_fully_qualified_name()}")
+        node.create_task(run_callback(node, self, self.callback_group, callback), name=f"guard condition of {node.get_fully_qualified_name()}")

@@ -58,9 +58,9 @@ class TopicEndpointInfo:
 
 def endpoints_of(node: Any, topic_name: str, kind: str, no_mangle: bool) -> list[TopicEndpointInfo]:
     """The graph's publishers (``kind="publisher"``) or subscriptions of ``topic_name``, seen from ``node``."""
-    runtime = node._runtime
-    if runtime is None:
+    if node.executor is None:  # not added to a runtime
         return []
+    runtime = node.runtime
     topic = topic_name if no_mangle else node.resolve_topic_name(topic_name)
     graph = runtime.graph
     found = graph.publishers_of(topic) if kind == "publisher" else graph.subscriptions_of(topic)

@@ -26,6 +26,8 @@ from typing import Any
 from .... import _services
 from ...._groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ..._context import Context
+from ...._node import Node as _AioNode
+from ....lowlevel import add_client
 from ..node import Node
 from ._driver import call_user, driver_of, start_on
 
@@ -63,7 +65,7 @@ class AsyncClock:
         self._destroyed = False
 
     def __getattr__(self, name: str) -> Any:
-        return getattr(self._node._clock, name)
+        return getattr(_AioNode.get_clock(self._node), name)
 
     def __repr__(self) -> str:
         return f"<AsyncClock of {self._node.get_fully_qualified_name()}>"
@@ -82,7 +84,7 @@ class AsyncClock:
         if duration_sec <= 0:
             await asyncio.sleep(0)
             return
-        clock = self._node._clock
+        clock = _AioNode.get_clock(self._node)
         loop = asyncio.get_running_loop()
         if not clock.ros_time_is_active:
             fut: asyncio.Future[Any] = loop.create_future()
@@ -286,10 +288,7 @@ class AsyncNode(Node):  # type: ignore[misc,valid-type]
         )
         client._context = self._context
         client._async_node = self
-        self._clients.append(client)
-        if self._runtime is not None:
-            self._runtime._bus.services.add(client)
-        return client
+        return add_client(self, client)
 
     def create_timer(self, timer_period_sec: float, callback: Callable[..., Any], autostart: bool = True, **internal: Any) -> Any:  # type: ignore[override]
         if self._internal():
