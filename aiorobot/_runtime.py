@@ -22,7 +22,7 @@ from ._priority import PriorityLoop
 from ._pubsub import Tap
 from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
-from ._transport import Transport, make_transport
+from ._transport import MAX_DOMAIN_ID, Transport, make_transport
 from ._waker import LoopWaker, TimerFdWaker, make_waker
 from ._watchdog import Watchdog
 
@@ -143,8 +143,8 @@ class Runtime:
         self._failure_logged: dict[tuple[str, str], float] = {}
         #: nodes whose on_start raised
         self._failed_starts: list[str] = []
-        if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
-            raise ValueError(f"domain_id: expected an int in 0..232, found {domain_id!r}")
+        if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= MAX_DOMAIN_ID:
+            raise ValueError(f"domain_id: expected an int in 0..{MAX_DOMAIN_ID}, found {domain_id!r}")
         self.transport = (
             transport if isinstance(transport, Transport) else make_transport(transport, domain_id=domain_id)
         )
