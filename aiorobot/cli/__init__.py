@@ -66,7 +66,7 @@ def _one_line_error(err: Exception) -> int | None:
     """A configuration error (exit 2) or a refused zenoh session (exit 1) that reached the top
     from any command, printed as its one line; None for anything else (a bug: the traceback stays).
     The classes are looked up only if their modules were imported, so raising them imported them."""
-    config = sys.modules.get("aiorobot._config")
+    config = sys.modules.get("aiorobot.launch._config")
     if config is not None and isinstance(err, config.ConfigError):
         print(err, file=sys.stderr)
         return 2
