@@ -74,7 +74,7 @@ def test_a_file_without_a_runtime_table_gets_the_runtimes_own_defaults(tmp_path)
         assert getattr(fields, name) == defaults[name], name
 
 
-def test_the_core_imports_no_launch_module_and_says_what_to_call_instead():
+def test_the_core_and_the_transports_import_no_launch_module_and_runtime_says_what_to_call_instead():
     code = (
         "import importlib, pkgutil, sys, aiorobot\n"
         "def load(path, prefix):\n"  # every core module: aiorobot._x, and aiorobot._x.y below a _x package
@@ -84,6 +84,7 @@ def test_the_core_imports_no_launch_module_and_says_what_to_call_instead():
         "            if info.ispkg:\n"
         "                load(module.__path__, info.name + '.')\n"
         "load(aiorobot.__path__, 'aiorobot.')\n"
+        "import aiorobot.transport\n"  # a transport's config errors are ConfigErrors too, from the core
         "loaded = sorted(m for m in sys.modules if m.startswith(('aiorobot.launch', 'aiorobot.bag', 'aiorobot.foxglove')))\n"
         "assert loaded == [], loaded\n"
         "from aiorobot._runtime import Runtime\n"
@@ -102,3 +103,6 @@ def test_the_package_root_keeps_the_config_names():
     assert aiorobot.load_config is aiorobot.launch.load_config
     assert aiorobot.ConfigError is aiorobot.launch.ConfigError
     assert aiorobot.GraphConfig is aiorobot.launch.GraphConfig
+    from aiorobot.transport import ZenohConfigError
+
+    assert issubclass(ZenohConfigError, aiorobot.ConfigError)

@@ -24,7 +24,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from .._errors import InvalidNameError
+from .._errors import ConfigError, InvalidNameError
 from .._names import expand_name, validate_namespace, validate_node_name
 from .._runtime import EXECUTORS, PRIORITY_STALL_THRESHOLD_SEC, SHUTDOWN_TIMEOUT_SEC, STALL_THRESHOLD_SEC
 from .._transport import MAX_DOMAIN_ID
@@ -90,31 +90,6 @@ _USE = re.compile(
 _TOML_POSITION = re.compile(
     r"^(?P<msg>.*) \(at (?:line (?P<line>\d+), column (?P<col>\d+)|end of document)\)$"
 )
-
-
-class ConfigError(Exception):
-    """A configuration file is unreadable, not TOML, or does not describe a valid graph.
-
-    Attributes
-    ----------
-    path : str
-        The file, as the user named it.
-    key : str or None
-        The key path inside the file (``nodes[1].executor``), ``None`` for file-level problems.
-    message : str
-        What was expected and what was found, on one line.
-    """
-
-    def __init__(self, path: str | Path, key: str | None, message: str) -> None:
-        self.path = str(path)
-        self.key = key
-        self.message = _one_line(message)
-        super().__init__(self.path, key, self.message)
-
-    def __str__(self) -> str:
-        if self.key:
-            return f"{self.path}: {self.key}: {self.message}"
-        return f"{self.path}: {self.message}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -701,7 +676,3 @@ def _toml_error_message(message: str, text: str) -> str:
         line = text.count("\n") + (0 if text.endswith("\n") else 1)
         return f"line {max(line, 1)}: invalid TOML: {reason} (at the end of the file)"
     return f"line {match['line']}, column {match['col']}: invalid TOML: {reason}"
-
-
-def _one_line(text: str) -> str:
-    return re.sub(r"\s*\n\s*", " ", text.strip())
