@@ -37,7 +37,7 @@ _EXPORTS = {
     "JumpThreshold": "_clock",
     "ROSClock": "_clock",
     "TimeJump": "_clock",
-    "ConfigError": "_config",
+    "ConfigError": "launch",
     "DurabilityPolicy": "_qos",
     "EventHandler": "_event_handler",
     "IncompatibleTypeInfo": "_event_handler",
@@ -64,7 +64,7 @@ _EXPORTS = {
     "GoalResponse": "_actions",
     "GoalStatus": "_actions",
     "Graph": "_graph",
-    "GraphConfig": "_config",
+    "GraphConfig": "launch",
     "HistoryPolicy": "_qos",
     "InvalidNameError": "_errors",
     "InvalidParameterValueError": "_errors",
@@ -103,7 +103,7 @@ _EXPORTS = {
     "TopicInfo": "_graph",
     "Transport": "_transport",
     "compile_kernels": "_warm_up",
-    "load_config": "_config",
+    "load_config": "launch",
     "qos_profile_sensor_data": "_qos",
     "qos_profile_system_default": "_qos",
     "run": "_runtime",
@@ -208,7 +208,7 @@ if TYPE_CHECKING:
     from ._actions import ActionClient, ActionServer, CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
     from ._clock import Clock, ClockChange, JumpHandle, JumpThreshold, ROSClock, TimeJump
     from ._clock_publisher import ClockPublisher
-    from ._config import ConfigError, GraphConfig, load_config
+    from .launch import ConfigError, GraphConfig, load_config
     from ._errors import InvalidParameterTypeError, ParameterImmutableError, ParameterUninitializedError
     from ._errors import InvalidNameError, InvalidParameterValueError, ParameterAlreadyDeclaredError, ParameterError, ParameterNotDeclaredError, QoSIncompatibleError, ServiceError
     from ._future import Future
@@ -230,6 +230,10 @@ if TYPE_CHECKING:
     from ._warm_up import compile_kernels
 
 
+#: Packages loaded with a public name because they plug into it (the core never imports them):
+#: aiorobot.launch installs the loader behind ``Runtime(config=...)``.
+_PLUGINS = {"Runtime": ("aiorobot.launch",)}
+
 _SUBPACKAGES = frozenset(
     {"control", "fusion", "lifecycle", "message_filters", "msgs", "parameters", "perception", "testing", "tf"}
 )
@@ -242,6 +246,8 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'aiorobot' has no attribute {name!r}")
     value = getattr(importlib.import_module(f"aiorobot.{module}"), name)
+    for plugin in _PLUGINS.get(name, ()):
+        importlib.import_module(plugin)
     globals()[name] = value
     return value
 

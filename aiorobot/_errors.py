@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import re
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
 __all__ = [
+    "ConfigError",
     "InvalidNameError",
     "InvalidParameterTypeError",
     "InvalidParameterValueError",
@@ -83,3 +90,34 @@ class ParameterUninitializedError(ParameterError):
 
 class ServiceError(RuntimeError):
     """A service call failed on the server side; the message carries the server's reason."""
+
+
+class ConfigError(Exception):
+    """A configuration file is unreadable or invalid: a graph file (aiorobot.launch) that is not
+    TOML or does not describe a valid graph, or a zenoh session config (aiorobot.transport's
+    ``ZenohConfigError``); one ``except ConfigError`` catches both.
+
+    Attributes
+    ----------
+    path : str
+        The file, as the user named it.
+    key : str or None
+        The key path inside the file (``nodes[1].executor``), ``None`` for file-level problems.
+    message : str
+        What was expected and what was found, on one line.
+    """
+
+    def __init__(self, path: str | Path, key: str | None, message: str) -> None:
+        self.path = str(path)
+        self.key = key
+        self.message = _one_line(message)
+        super().__init__(self.path, key, self.message)
+
+    def __str__(self) -> str:
+        if self.key:
+            return f"{self.path}: {self.key}: {self.message}"
+        return f"{self.path}: {self.message}"
+
+
+def _one_line(text: str) -> str:
+    return re.sub(r"\s*\n\s*", " ", text.strip())

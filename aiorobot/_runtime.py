@@ -10,7 +10,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Coroutine
+from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ._bus import Bus, Incompatibility
@@ -22,14 +22,14 @@ from ._priority import PriorityLoop
 from ._pubsub import Tap
 from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
-from ._transport import Transport, make_transport
+from ._transport import MAX_DOMAIN_ID, Transport, make_transport
 from ._waker import LoopWaker, TimerFdWaker, make_waker
 from ._watchdog import Watchdog
 
 if TYPE_CHECKING:
     import concurrent.futures
 
-__all__ = ["Runtime", "run"]
+__all__ = ["ConfigLoader", "Runtime", "install_config_loader", "run"]
 
 _log = logging.getLogger("aiorobot.runtime")
 T = TypeVar("T")
@@ -46,6 +46,19 @@ FLUSH_TIMEOUT_SEC = 1.0
 STALL_THRESHOLD_SEC = 0.5
 PRIORITY_STALL_THRESHOLD_SEC = 0.05
 
+#: What ``Runtime(config=...)`` calls with its ``config``: returns the keyword arguments of
+#: :class:`Runtime` that the file sets, and the builder of its nodes (``[(node, executor), ...]``,
+#: called on entry, before anything starts). The core reads no config file: aiorobot.launch
+#: installs this (``aiorobot.launch.open_runtime`` is the call for new code).
+ConfigLoader = Callable[[Any], "tuple[dict[str, Any], Callable[[], list[tuple[Node, str]]]]"]
+_config_loader: ConfigLoader | None = None
+
+
+def install_config_loader(loader: ConfigLoader) -> None:
+    """Make ``Runtime(config=...)`` read its file with ``loader`` (aiorobot.launch installs its own)."""
+    global _config_loader
+    _config_loader = loader
+
 
 class Runtime:
     """Runs nodes: ``async with Runtime() as rt: rt.add_node(node); await rt.spin()``.
@@ -61,8 +74,9 @@ class Runtime:
     strict_qos
         Raise :class:`QoSIncompatibleError` instead of warning when endpoints do not connect.
     config
-        A config file path (``aiorobot run`` format): its runtime settings apply and its
-        nodes are built, validated and added on entry.
+        A config file path (``aiorobot run`` format) or a loaded ``GraphConfig``, read by
+        aiorobot.launch (see ``aiorobot.launch.open_runtime``): its runtime settings replace
+        the arguments above and its nodes are built, validated and added on entry.
     process_workers, thread_workers
         Sizes of the pools behind ``Node.offload`` and ``Node.run_in_thread``.
     priority_realtime
@@ -103,28 +117,24 @@ class Runtime:
         stall_threshold: float = STALL_THRESHOLD_SEC,
         priority_stall_threshold: float = PRIORITY_STALL_THRESHOLD_SEC,
     ) -> None:
-        self._config = config
+        #: builds the config file's nodes on entry (``config=``)
+        self._config_nodes: Callable[[], list[tuple[Node, str]]] | None = None
         if config is not None:
-            from ._config import load_config
-
-            cfg = load_config(os.fspath(config)) if isinstance(config, (str, os.PathLike)) else config
-            self._config = cfg
-            if cfg.child_processes:
-                raise ValueError(
-                    f"{cfg.path}: its nodes run in several processes ({', '.join(cfg.child_processes)}); "
-                    "a Runtime is one process: start the file with aiorobot run"
+            if _config_loader is None:
+                raise TypeError(
+                    "Runtime(config=...): reading a graph file needs aiorobot.launch, which is not imported; "
+                    "use aiorobot.launch.open_runtime(config) (or import aiorobot.launch first)"
                 )
-            transport = cfg.runtime.transport
-            if cfg.runtime.zenoh_config:
-                transport = make_transport("zenoh", domain_id=cfg.runtime.domain_id, config_file=cfg.runtime.zenoh_config)
-            domain_id = cfg.runtime.domain_id
-            use_sim_time = cfg.runtime.use_sim_time
-            strict_qos = cfg.runtime.strict_qos
-            priority_realtime = cfg.runtime.priority_realtime
-            debug_messages = cfg.runtime.debug_messages
-            shutdown_timeout = cfg.runtime.shutdown_timeout
-            stall_threshold = cfg.runtime.stall_threshold
-            priority_stall_threshold = cfg.runtime.priority_stall_threshold
+            settings, self._config_nodes = _config_loader(config)
+            transport = settings["transport"]
+            domain_id = settings["domain_id"]
+            use_sim_time = settings["use_sim_time"]
+            strict_qos = settings["strict_qos"]
+            priority_realtime = settings["priority_realtime"]
+            debug_messages = settings["debug_messages"]
+            shutdown_timeout = settings["shutdown_timeout"]
+            stall_threshold = settings["stall_threshold"]
+            priority_stall_threshold = settings["priority_stall_threshold"]
         for name, value in (
             ("shutdown_timeout", shutdown_timeout),
             ("stall_threshold", stall_threshold),
@@ -143,8 +153,8 @@ class Runtime:
         self._failure_logged: dict[tuple[str, str], float] = {}
         #: nodes whose on_start raised
         self._failed_starts: list[str] = []
-        if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
-            raise ValueError(f"domain_id: expected an int in 0..232, found {domain_id!r}")
+        if isinstance(domain_id, bool) or not isinstance(domain_id, int) or not 0 <= domain_id <= MAX_DOMAIN_ID:
+            raise ValueError(f"domain_id: expected an int in 0..{MAX_DOMAIN_ID}, found {domain_id!r}")
         self.transport = (
             transport if isinstance(transport, Transport) else make_transport(transport, domain_id=domain_id)
         )
@@ -195,11 +205,8 @@ class Runtime:
     async def __aenter__(self) -> Runtime:
         if self._state != "new":
             raise RuntimeError(f"{self!r} cannot be entered twice")
-        built: list[tuple[Node, str]] = []
-        if self._config is not None:
-            from ._config import build_nodes
-
-            built = build_nodes(self._config)  # validate everything before anything starts
+        # a config file's nodes: validate everything before anything starts
+        built = self._config_nodes() if self._config_nodes is not None else []
         self._loop = asyncio.get_running_loop()
         self._thread_id = threading.get_ident()
         self._waker = make_waker(self._loop, precise=True)

@@ -25,7 +25,10 @@ if TYPE_CHECKING:
     from ._graph import NodeInfo
     from ._node import Node
 
-__all__ = ["LocalTransport", "Transport", "make_transport"]
+__all__ = ["MAX_DOMAIN_ID", "LocalTransport", "Transport", "make_transport"]
+
+#: The largest ROS domain id (``ROS_DOMAIN_ID``, ``Runtime(domain_id=)``, ``[runtime] domain_id``).
+MAX_DOMAIN_ID = 232
 
 
 class Transport:
@@ -84,8 +87,8 @@ def make_transport(name: str, *, domain_id: int = 0, **options: Any) -> Transpor
 
         if domain_id == 0 and os.environ.get("ROS_DOMAIN_ID", "").strip():
             raw = os.environ["ROS_DOMAIN_ID"].strip()
-            if not raw.isdigit() or not 0 <= int(raw) <= 232:
-                raise ValueError(f"ROS_DOMAIN_ID: expected an int in 0..232, found {raw!r}")
+            if not raw.isdigit() or not 0 <= int(raw) <= MAX_DOMAIN_ID:
+                raise ValueError(f"ROS_DOMAIN_ID: expected an int in 0..{MAX_DOMAIN_ID}, found {raw!r}")
             domain_id = int(raw)
         return ZenohTransport(domain_id=domain_id, **options)
     raise ValueError(f"transport: expected 'local' or 'zenoh', found {name!r}")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from aiorobot._config import ConfigError, GraphConfig, NodeConfig, RuntimeConfig, load_config
+from aiorobot.launch import ConfigError, GraphConfig, NodeConfig, RuntimeConfig, load_config
 
 CONFIGS = Path(__file__).parent / "configs"
 BAD_PARSE = sorted((CONFIGS / "bad").glob("*.toml"))

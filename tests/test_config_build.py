@@ -11,8 +11,7 @@ from pathlib import Path
 import pytest
 
 from aiorobot import Node
-from aiorobot._config import ConfigError, load_config
-from aiorobot._config_build import build_nodes
+from aiorobot.launch import ConfigError, build_nodes, load_config
 
 BUILD_CONFIGS = Path(__file__).parent / "configs" / "build"
 BAD_BUILD = sorted(BUILD_CONFIGS.glob("*.toml"))

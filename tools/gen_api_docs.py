@@ -21,7 +21,10 @@ __all__ = ["PACKAGES", "render"]
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "api.md"
 #: the packages documented, in order (aiorobot's subpackages that users import by name)
-PACKAGES = ("aiorobot", "aiorobot.tf", "aiorobot.message_filters", "aiorobot.lifecycle", "aiorobot.testing", "aiorobot.lowlevel", "aiorobot.control")
+PACKAGES = (
+    "aiorobot", "aiorobot.launch", "aiorobot.tf", "aiorobot.message_filters", "aiorobot.lifecycle", "aiorobot.testing",
+    "aiorobot.lowlevel", "aiorobot.control",
+)
 
 
 def _first_paragraph(obj: object) -> str:

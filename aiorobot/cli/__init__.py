@@ -65,9 +65,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _one_line_error(err: Exception) -> int | None:
     """A configuration error (exit 2) or a refused zenoh session (exit 1) that reached the top
     from any command, printed as its one line; None for anything else (a bug: the traceback stays).
-    The classes are looked up only if their modules were imported, so raising them imported them."""
-    config = sys.modules.get("aiorobot._config")
-    if config is not None and isinstance(err, config.ConfigError):
+    The session error is looked up only if its module was imported, so raising it imported it."""
+    from aiorobot._errors import ConfigError  # the core's exceptions: imports nothing else
+
+    if isinstance(err, ConfigError):
         print(err, file=sys.stderr)
         return 2
     session = sys.modules.get("aiorobot.transport._session_config")

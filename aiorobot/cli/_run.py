@@ -26,7 +26,7 @@ from ._parser import positive_seconds
 
 if TYPE_CHECKING:
     from aiorobot import Node, Runtime
-    from aiorobot._config import GraphConfig
+    from aiorobot.launch import GraphConfig
 
 __all__ = ["add_arguments", "main"]
 
@@ -89,7 +89,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from aiorobot._config import ConfigError, load_config
+    from aiorobot.launch import ConfigError, load_config
 
     from ._run_node import is_node_spec, run_node
 
@@ -125,7 +125,7 @@ def main(args: argparse.Namespace) -> int:
 
     configure_logging(config.runtime.log_level)
     try:
-        from aiorobot._config_build import build_nodes
+        from aiorobot.launch import build_nodes
 
         # Constructors run here, outside the event loop: a Ctrl-C interrupts one that blocks.
         nodes = build_nodes(config, process)  # raises ConfigError before anything starts
@@ -143,7 +143,7 @@ def main(args: argparse.Namespace) -> int:
 
 def _process_of(args: argparse.Namespace, config: GraphConfig) -> str | None:
     """The process this invocation runs (``--process``, default ``main``); None after printing an error."""
-    from aiorobot._config import MAIN_PROCESS
+    from aiorobot.launch import MAIN_PROCESS
 
     process = getattr(args, "process", None) or MAIN_PROCESS
     known = (MAIN_PROCESS, *config.child_processes)
@@ -186,7 +186,7 @@ async def _serve_process(
     group: Any,
 ) -> int:
     from aiorobot import Runtime
-    from aiorobot._config import ConfigError
+    from aiorobot.launch import ConfigError, runtime_options
     from aiorobot.lowlevel import set_on_failure
     from ._status import StatusDisplay
 
@@ -195,22 +195,11 @@ async def _serve_process(
     runtime_config = config.runtime
     from aiorobot._transport import make_transport
 
-    transport: Any = runtime_config.transport
-    if runtime_config.zenoh_config:
-        transport = make_transport("zenoh", domain_id=runtime_config.domain_id, config_file=runtime_config.zenoh_config)
-    elif group.endpoints:  # a multi-process graph: the processes meet at the supervisor's endpoint
-        transport = make_transport("zenoh", domain_id=runtime_config.domain_id, **group.endpoints)
-    async with Runtime(
-        transport=transport,
-        domain_id=runtime_config.domain_id,
-        use_sim_time=runtime_config.use_sim_time,
-        strict_qos=runtime_config.strict_qos,
-        priority_realtime=runtime_config.priority_realtime,
-        debug_messages=runtime_config.debug_messages,
-        shutdown_timeout=runtime_config.shutdown_timeout,
-        stall_threshold=runtime_config.stall_threshold,
-        priority_stall_threshold=runtime_config.priority_stall_threshold,
-    ) as rt:
+    options = runtime_options(config)  # the Runtime arguments set by the [runtime] table
+    # a multi-process graph (no zenoh_config of its own): the processes meet at the supervisor's endpoint
+    if group.endpoints and not runtime_config.zenoh_config:
+        options["transport"] = make_transport("zenoh", domain_id=runtime_config.domain_id, **group.endpoints)
+    async with Runtime(**options) as rt:
         # Signal handlers stay installed until the runtime has fully shut down: a second
         # Ctrl-C abandons what is blocked, a first one past shutdown_timeout too.
         if runtime_config.strict_qos:  # the graph as written cannot connect: refuse it whole

@@ -12,7 +12,7 @@ loopback port) and, through zenoh's gossip, to the other children.
 * A child's stdout and stderr lines come out of ``aiorobot run``'s with ``[name] `` in front.
 * A child reads its stdin, a pipe from the supervisor: end of file (the supervisor died,
   even by SIGKILL) shuts it down, so no child outlives its supervisor.
-* ``[processes.<name>]`` sets the restart policy (see :class:`aiorobot._config.ProcessConfig`).
+* ``[processes.<name>]`` sets the restart policy (see :class:`aiorobot.launch.ProcessConfig`).
   A child ending with status 2 (a configuration error) is never restarted.
 """
 
@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from aiorobot._config import GraphConfig, ProcessConfig
+    from aiorobot.launch import GraphConfig, ProcessConfig
 
 __all__ = ["ProcessGroup", "ProcessSupervisor", "describe_status"]
 
@@ -274,7 +274,7 @@ class ProcessGroup:
     def __init__(
         self, config: GraphConfig, process: str, *, supervisor: str | None, supervise: bool, status_period_sec: float
     ) -> None:
-        from aiorobot._config import MAIN_PROCESS
+        from aiorobot.launch import MAIN_PROCESS
         from aiorobot.transport._zenoh import DEFAULT_CONNECT
 
         self._config = config

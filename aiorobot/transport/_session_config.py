@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._config import ConfigError
+from .._errors import ConfigError
 
 __all__ = [
     "ALLOW_PLAIN_ENV",

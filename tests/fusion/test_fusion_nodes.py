@@ -241,7 +241,7 @@ async def test_complementary_filter_publishes_fused_orientation_with_the_imu_sta
 async def test_example_config_builds_both_filters_on_the_priority_loop_and_fuses_odometry(tmp_path):
     from pathlib import Path
 
-    from aiorobot._config import build_nodes, load_config
+    from aiorobot.launch import build_nodes, load_config
 
     example = Path(__file__).resolve().parents[2] / "examples" / "fusion_ekf.toml"
     built = build_nodes(load_config(example))
@@ -261,7 +261,7 @@ async def test_example_config_builds_both_filters_on_the_priority_loop_and_fuses
 
 
 def test_config_with_a_misspelt_parameter_names_the_nearest_valid_one(tmp_path):
-    from aiorobot._config import ConfigError, build_nodes, load_config
+    from aiorobot.launch import ConfigError, build_nodes, load_config
 
     path = tmp_path / "bad.toml"
     path.write_text(

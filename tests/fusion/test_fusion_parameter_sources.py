@@ -85,7 +85,7 @@ def _from_file(cls, tmp_path):
 
 
 def _from_toml(cls, tmp_path):
-    from aiorobot._config import build_nodes, load_config
+    from aiorobot.launch import build_nodes, load_config
 
     table = ", ".join(f"{key} = {_toml(value)}" for key, value in VALUES.items())
     path = tmp_path / "graph.toml"

@@ -7,8 +7,7 @@ import textwrap
 import pytest
 
 from aiorobot import Node
-from aiorobot._config import ConfigError, load_config
-from aiorobot._config_build import build_nodes
+from aiorobot.launch import ConfigError, build_nodes, load_config
 
 NODES = """
 from aiorobot import Node

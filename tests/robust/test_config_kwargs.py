@@ -6,8 +6,7 @@ import textwrap
 
 import pytest
 
-from aiorobot._config import ConfigError, load_config
-from aiorobot._config_build import build_nodes
+from aiorobot.launch import ConfigError, build_nodes, load_config
 
 NODES = textwrap.dedent(
     '''

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from aiorobot._config import load_config
+from aiorobot.launch import load_config
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "mecanum_serial.toml"
 

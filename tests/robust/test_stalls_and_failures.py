@@ -9,7 +9,7 @@ import time
 import pytest
 
 from aiorobot import Node, Runtime
-from aiorobot._config import ConfigError, load_config
+from aiorobot.launch import ConfigError, load_config
 
 
 class Blocker(Node):

@@ -172,7 +172,7 @@ async def test_same_seed_gives_identical_bytes_and_another_seed_does_not() -> No
     ],
 )
 def test_bad_parameters_give_one_config_error_and_nothing_starts(tmp_path: Path, parameters: dict[str, Any], message: str) -> None:
-    from aiorobot._config import ConfigError, build_nodes, load_config
+    from aiorobot.launch import ConfigError, build_nodes, load_config
 
     items = ", ".join(f"{k} = {v!r}".replace("'", '"') for k, v in parameters.items())
     path = tmp_path / "sim.toml"
@@ -212,7 +212,7 @@ async def test_system_time_source_stamps_with_system_time_per_step_and_publishes
 
 
 def test_example_config_builds() -> None:
-    from aiorobot._config import build_nodes, load_config
+    from aiorobot.launch import build_nodes, load_config
 
     config = load_config(Path(__file__).parents[2] / "examples" / "sim.toml")
     nodes = build_nodes(config)

@@ -69,7 +69,7 @@ def test_bad_parameters_are_one_clear_error(overrides, words):
 
 
 def test_builds_from_a_config_with_nested_parameter_tables(tmp_path):
-    from aiorobot._config import build_nodes, load_config
+    from aiorobot.launch import build_nodes, load_config
 
     path = tmp_path / "graph.toml"
     path.write_text(textwrap.dedent("""

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from aiorobot._config import ConfigError, parse_config
+from aiorobot.launch import ConfigError, parse_config
 
 NODES = '''
 import os

@@ -1,9 +1,9 @@
 """The building half of the config loader: import node classes and construct the nodes.
 
-:func:`build_nodes` turns a validated :class:`~aiorobot._config.GraphConfig` into node
+:func:`build_nodes` turns a validated :class:`~aiorobot.launch.GraphConfig` into node
 objects, checking everything that needs the classes themselves (importable module and
 class, an ``aiorobot.Node`` subclass, declared and well-typed parameters, unique names)
-before anything is started. Problems raise :class:`~aiorobot._config.ConfigError`.
+before anything is started. Problems raise :class:`~aiorobot.launch.ConfigError`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from ._config import MAIN_PROCESS, ConfigError, GraphConfig, NodeConfig
-from ._errors import InvalidParameterValueError
+from .._errors import InvalidParameterValueError
 
 if TYPE_CHECKING:
     from aiorobot import Node

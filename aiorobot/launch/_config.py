@@ -1,7 +1,7 @@
 """The graph configuration read by ``aiorobot run``: a TOML file parsed into frozen dataclasses.
 
 This module is the pure half of the loader: :func:`load_config` reads and validates a
-file and never imports user code or builds a node. :func:`aiorobot._config_build.build_nodes`
+file and never imports user code or builds a node. :func:`aiorobot.launch.build_nodes`
 is the other half (imports the node classes and constructs the nodes).
 
 Every problem raises :class:`ConfigError` naming the file, the key path (``nodes[1].executor``)
@@ -24,8 +24,10 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from ._errors import InvalidNameError
-from ._names import expand_name, validate_namespace, validate_node_name
+from .._errors import ConfigError, InvalidNameError
+from .._names import expand_name, validate_namespace, validate_node_name
+from .._runtime import EXECUTORS, PRIORITY_STALL_THRESHOLD_SEC, SHUTDOWN_TIMEOUT_SEC, STALL_THRESHOLD_SEC
+from .._transport import MAX_DOMAIN_ID
 
 __all__ = [
     "EXECUTORS",
@@ -45,11 +47,9 @@ __all__ = [
     "parse_config",
 ]
 
-EXECUTORS = ("main", "priority")
 LOG_LEVELS = ("debug", "info", "warning", "error")
 TRANSPORTS = ("local", "zenoh")
 _AVAILABLE_TRANSPORTS = ("local", "zenoh")
-_MAX_DOMAIN_ID = 232
 
 _RUNTIME_KEYS = (
     "transport",
@@ -92,31 +92,6 @@ _TOML_POSITION = re.compile(
 )
 
 
-class ConfigError(Exception):
-    """A configuration file is unreadable, not TOML, or does not describe a valid graph.
-
-    Attributes
-    ----------
-    path : str
-        The file, as the user named it.
-    key : str or None
-        The key path inside the file (``nodes[1].executor``), ``None`` for file-level problems.
-    message : str
-        What was expected and what was found, on one line.
-    """
-
-    def __init__(self, path: str | Path, key: str | None, message: str) -> None:
-        self.path = str(path)
-        self.key = key
-        self.message = _one_line(message)
-        super().__init__(self.path, key, self.message)
-
-    def __str__(self) -> str:
-        if self.key:
-            return f"{self.path}: {self.key}: {self.message}"
-        return f"{self.path}: {self.message}"
-
-
 @dataclass(frozen=True, slots=True)
 class RuntimeConfig:
     """The ``[runtime]`` table: arguments of :class:`aiorobot.Runtime` and the default log level."""
@@ -130,9 +105,9 @@ class RuntimeConfig:
     debug_messages: bool = False
     parameters_file: str | None = None  # a ROS 2 YAML parameter file for every node (absolute path)
     zenoh_config: str | None = None  # a zenoh session config file (JSON5) for routers, TLS, access control
-    shutdown_timeout: float = 2.0
-    stall_threshold: float = 0.5
-    priority_stall_threshold: float = 0.05
+    shutdown_timeout: float = SHUTDOWN_TIMEOUT_SEC
+    stall_threshold: float = STALL_THRESHOLD_SEC
+    priority_stall_threshold: float = PRIORITY_STALL_THRESHOLD_SEC
 
 
 @dataclass(frozen=True, slots=True)
@@ -271,9 +246,9 @@ def load_config(path: str | Path) -> GraphConfig:
 def build_nodes(config: GraphConfig, process: str = MAIN_PROCESS) -> list[tuple[Any, str]]:
     """Import the node classes of ``config`` and construct the nodes: ``[(node, executor), ...]``.
 
-    See :func:`aiorobot._config_build.build_nodes` (imported lazily: this module stays pure).
+    See :func:`aiorobot.launch.build_nodes` (imported lazily: this module stays pure).
     """
-    from ._config_build import build_nodes as _build_nodes
+    from ._build import build_nodes as _build_nodes
 
     return _build_nodes(config, process)
 
@@ -359,10 +334,10 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
             f'the "{transport}" transport is not available yet; expected "local"',
         )
     domain_id = table.get("domain_id", 0)
-    checker.check_type(domain_id, "runtime.domain_id", int, f"an integer 0..{_MAX_DOMAIN_ID}")
-    if not 0 <= domain_id <= _MAX_DOMAIN_ID:
+    checker.check_type(domain_id, "runtime.domain_id", int, f"an integer 0..{MAX_DOMAIN_ID}")
+    if not 0 <= domain_id <= MAX_DOMAIN_ID:
         raise checker.error(
-            "runtime.domain_id", f"expected an integer 0..{_MAX_DOMAIN_ID}, found {domain_id}"
+            "runtime.domain_id", f"expected an integer 0..{MAX_DOMAIN_ID}, found {domain_id}"
         )
     use_sim_time = table.get("use_sim_time", False)
     checker.check_type(use_sim_time, "runtime.use_sim_time", bool, "true or false")
@@ -383,14 +358,18 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
         if transport != "zenoh":
             raise checker.error("runtime.zenoh_config", 'only applies with transport = "zenoh"')
         zenoh_config = str(resolved)
-        from .transport._session_config import check_session_file
+        from ..transport._session_config import check_session_file
 
         try:  # parses, its certificates are there, no plain endpoint past TLS: before anything starts
             check_session_file(zenoh_config)
         except ConfigError as err:
             raise checker.error("runtime.zenoh_config", str(err)) from None
     seconds = {}
-    for name, default in (("shutdown_timeout", 2.0), ("stall_threshold", 0.5), ("priority_stall_threshold", 0.05)):
+    for name, default in (
+        ("shutdown_timeout", SHUTDOWN_TIMEOUT_SEC),
+        ("stall_threshold", STALL_THRESHOLD_SEC),
+        ("priority_stall_threshold", PRIORITY_STALL_THRESHOLD_SEC),
+    ):
         value = table.get(name, default)
         checker.check_type(value, f"runtime.{name}", (int, float), "a number of seconds > 0")
         if isinstance(value, bool) or not value > 0:
@@ -503,7 +482,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
 
 def _parameters_file(checker: _Checker, table: Mapping[str, Any], key: str) -> str | None:
     """``parameters_file = "params.yaml"`` (relative to the config file): exists and parses."""
-    from .parameters._files import ParameterFileError, load_parameter_file
+    from ..parameters._files import ParameterFileError, load_parameter_file
 
     if "parameters_file" not in table:
         return None
@@ -697,7 +676,3 @@ def _toml_error_message(message: str, text: str) -> str:
         line = text.count("\n") + (0 if text.endswith("\n") else 1)
         return f"line {max(line, 1)}: invalid TOML: {reason} (at the end of the file)"
     return f"line {match['line']}, column {match['col']}: invalid TOML: {reason}"
-
-
-def _one_line(text: str) -> str:
-    return re.sub(r"\s*\n\s*", " ", text.strip())
