@@ -29,7 +29,7 @@ import numpy as np
 
 from ._images import BadInput, image_array
 from ._ring import FrameRing
-from ._worker import Frame, worker_main
+from ._worker import READY, Frame, worker_main
 
 __all__ = ["POLICIES", "Pipeline", "PipelineStatistics", "StageLatency"]
 
@@ -75,13 +75,14 @@ class PipelineStatistics:
 
 
 class _Worker:
-    __slots__ = ("index", "process", "conn", "job", "dead", "served")
+    __slots__ = ("index", "process", "conn", "job", "dead", "served", "ready")
 
     def __init__(self, index: int, process: Any, conn: Any) -> None:
         self.index, self.process, self.conn = index, process, conn
         self.job: tuple[int, int, Frame, float, float] | None = None  # id, slot, frame, arrival, dispatch
         self.dead = False
         self.served = 0
+        self.ready = False  # its READY message arrived
 
 
 def _context() -> Any:
@@ -167,6 +168,18 @@ class Pipeline:
         """Create the ring and start the workers (the first frame does this too). Idempotent."""
         if self._ring is None:
             self._start_now()
+
+    async def wait_ready(self) -> None:
+        """Start the workers if they are not yet, and return once every one has come up (its
+        process started, the frame ring attached, the kernel's module imported). A frame that
+        arrives before then waits in the queue (or is dropped by the queue policy), so a graph
+        that must not lose its first frames to worker start-up waits here first."""
+        if self._ready is None:
+            self._ready = asyncio.Event()
+            if self._workers and all(w.ready for w in self._workers if not w.dead):
+                self._ready.set()
+        await self.start()
+        await self._ready.wait()
 
     def _start_now(self) -> None:
         self._loop = asyncio.get_running_loop()
@@ -319,6 +332,11 @@ class Pipeline:
 
     def _on_reply(self, worker: _Worker, reply: tuple[int, str, Any, float, float]) -> None:
         received = time.monotonic()
+        if reply == READY:
+            worker.ready = True
+            if self._ready is not None and all(w.ready for w in self._workers if not w.dead):
+                self._ready.set()
+            return
         job_id, status, result, start, end = reply
         job = worker.job
         if job is None or job[0] != job_id:

@@ -12,7 +12,10 @@ from typing import Any
 from ._images import BadInput
 from ._ring import RingAttachment
 
-__all__ = ["Frame", "worker_main"]
+__all__ = ["READY", "Frame", "worker_main"]
+
+#: a worker's first message: ``(job, status, result, t_start, t_end)`` with no job, before any job is sent
+READY = (-1, "ready", None, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -41,13 +44,14 @@ def _header(stamp: tuple[int, int] | None, frame_id: str) -> Any:
 def worker_main(conn: Any, ring_name: str, slot_bytes: int, kernel: Callable[..., Any]) -> None:
     """Serve jobs ``(job, slot, shape, dtype, stamp, frame_id, encoding, context)`` until the pipe closes or ``None`` arrives.
 
-    Replies ``(job, status, result, t_start, t_end)``; ``status`` is ``"ok"``,
+    First sends :data:`READY`, then replies ``(job, status, result, t_start, t_end)``; ``status`` is ``"ok"``,
     ``"bad"`` (the kernel raised :class:`BadInput`) or ``"error"`` (any other
     exception, with its traceback). A kernel's exception never ends the worker.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides when workers stop
     ring = RingAttachment(ring_name, slot_bytes)
     try:
+        conn.send(READY)  # up, the ring attached and the kernel's module imported (it came unpickled)
         while True:
             try:
                 job = conn.recv()

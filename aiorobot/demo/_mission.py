@@ -17,6 +17,8 @@ import numpy as np
 __all__ = ["MISSIONS", "DemoSetupError", "DemoSummary", "mission_for", "parse_waypoints", "run_demo"]
 
 _PI = math.pi
+#: how long the demo waits for its perception workers to come up before starting the simulator
+PERCEPTION_START_TIMEOUT_SEC = 60.0
 #: The shipped missions: (x, y, yaw) waypoints per built-in world.
 MISSIONS: dict[str, list[tuple[float, float, float]]] = {
     "warehouse": [
@@ -361,7 +363,18 @@ async def run_demo(
     sim, server = graph.simulator, graph.server
     baseline: _SleepBaseline | None = None
     async with Runtime(use_sim_time=graph.time_source == "sim", stall_threshold=10.0, priority_realtime=realtime) as rt:
-        rt.add_nodes(graph.nodes)
+        # the simulator last, once the perception workers are up: at --rtf 0 a short mission can be over
+        # before a loaded machine has started them, and every frame until then is dropped
+        rt.add_nodes([(node, executor) for node, executor in graph.nodes if node is not sim])
+        if graph.aruco is not None:
+            try:
+                async with asyncio.timeout(PERCEPTION_START_TIMEOUT_SEC):
+                    await graph.aruco.pipeline.wait_ready()
+            except TimeoutError:
+                logging.getLogger("aiorobot.demo").warning(
+                    f"the perception workers did not come up within {PERCEPTION_START_TIMEOUT_SEC:g} s; "
+                    "starting without them")
+        rt.add_nodes([(node, executor) for node, executor in graph.nodes if node is sim])
         nav = rt.add_node(Navigator())
         monitor = _Monitor(rt.add_node(Node("demo_monitor")), summary)
         poses = [pose_stamped(x, y, yaw) for x, y, yaw in waypoints]
