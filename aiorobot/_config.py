@@ -24,8 +24,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from ._errors import InvalidNameError
-from ._names import expand_name, validate_namespace, validate_node_name
+from ._core._errors import InvalidNameError
+from ._core._names import expand_name, validate_namespace, validate_node_name
 
 __all__ = [
     "EXECUTORS",

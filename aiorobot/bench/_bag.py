@@ -98,8 +98,8 @@ def _serialise_cost(duration: float, published: dict[str, int]) -> float:
 
 async def _play_spacing(quick: bool, tmp: Path) -> dict[str, Any]:
     from aiorobot import Runtime
-    from aiorobot._pubsub import Tap
-    from aiorobot._qos import QoSProfile
+    from aiorobot._core._pubsub import Tap
+    from aiorobot._core._qos import QoSProfile
     from aiorobot.bag import BagWriter, Player
     from aiorobot.msgs import serialize
     from aiorobot.msgs.std_msgs import UInt32

@@ -192,7 +192,7 @@ async def _serve_process(
     for (node, _), node_config in zip(nodes, config.nodes):
         node._on_failure = "continue" if keep_going and node_config.on_failure == "stop" else node_config.on_failure
     runtime_config = config.runtime
-    from aiorobot._transport import make_transport
+    from aiorobot._core._transport import make_transport
 
     transport: Any = runtime_config.transport
     if runtime_config.zenoh_config:
@@ -234,7 +234,7 @@ async def _serve_process(
 
 def _outcome(rt: Runtime) -> int:
     """Print what went wrong during the run; 1 if a node failed to start or a callback raised."""
-    from aiorobot._watchdog import EXIT_SHUTDOWN_TIMEOUT
+    from aiorobot._core._watchdog import EXIT_SHUTDOWN_TIMEOUT
 
     stats = rt.statistics()
     lines = []

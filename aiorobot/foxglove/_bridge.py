@@ -20,9 +20,9 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
-from .._node import Node
-from .._pubsub import Endpoint, Publisher, Tap
-from .._qos import QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._pubsub import Endpoint, Publisher, Tap
+from .._core._qos import QoSProfile, ReliabilityPolicy
 
 __all__ = ["FoxgloveBridge", "FoxgloveStatistics"]
 

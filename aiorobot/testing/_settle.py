@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import asyncio
 
-from .._runtime import Runtime
+from .._core._runtime import Runtime
 
 __all__ = ["settle"]
 

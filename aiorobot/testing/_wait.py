@@ -5,8 +5,8 @@ from __future__ import annotations
 import asyncio
 from typing import TypeVar
 
-from .._node import Node
-from .._qos import QoSProfile
+from .._core._node import Node
+from .._core._qos import QoSProfile
 
 __all__ = ["wait_for_message"]
 

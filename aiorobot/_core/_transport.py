@@ -1,6 +1,6 @@
 """The transport seam: how a runtime's in-process bus reaches other processes.
 
-Every runtime has a :class:`~aiorobot._bus.Bus` that connects endpoints in its
+Every runtime has a :class:`~aiorobot._core._bus.Bus` that connects endpoints in its
 process zero-copy. A transport extends that bus outwards. It sees every local
 endpoint come and go, and it takes part in the bus as ordinary endpoints:
 
@@ -80,7 +80,7 @@ def make_transport(name: str, *, domain_id: int = 0, **options: Any) -> Transpor
     if name == "local":
         return LocalTransport(domain_id=domain_id)
     if name == "zenoh":
-        from .transport import ZenohTransport
+        from ..transport import ZenohTransport
 
         if domain_id == 0 and os.environ.get("ROS_DOMAIN_ID", "").strip():
             raw = os.environ["ROS_DOMAIN_ID"].strip()

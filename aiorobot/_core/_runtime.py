@@ -53,7 +53,7 @@ class Runtime:
     Parameters
     ----------
     transport
-        ``"local"`` (one process) or a :class:`~aiorobot._transport.Transport`.
+        ``"local"`` (one process) or a :class:`~aiorobot._core._transport.Transport`.
     domain_id
         Separates graphs on a shared network (as ``ROS_DOMAIN_ID``).
     use_sim_time
@@ -105,7 +105,7 @@ class Runtime:
     ) -> None:
         self._config = config
         if config is not None:
-            from ._config import load_config
+            from .._config import load_config
 
             cfg = load_config(os.fspath(config)) if isinstance(config, (str, os.PathLike)) else config
             self._config = cfg
@@ -197,7 +197,7 @@ class Runtime:
             raise RuntimeError(f"{self!r} cannot be entered twice")
         built: list[tuple[Node, str]] = []
         if self._config is not None:
-            from ._config import build_nodes
+            from .._config import build_nodes
 
             built = build_nodes(self._config)  # validate everything before anything starts
         self._loop = asyncio.get_running_loop()
@@ -214,7 +214,7 @@ class Runtime:
             self._waker = None
             raise
         if self.use_sim_time:
-            from .msgs.rosgraph_msgs import Clock as ClockMsg
+            from ..msgs.rosgraph_msgs import Clock as ClockMsg
 
             self._clock_tap = Tap(
                 ClockMsg,
@@ -229,7 +229,7 @@ class Runtime:
             self._bus.add_subscription(self._clock_tap)
         self._state = "running"
         if self._bus.debug_messages:
-            from .msgs._classgen import enable_assignment_checks
+            from ..msgs._classgen import enable_assignment_checks
 
             enable_assignment_checks()  # message field assignments are type and range checked
             self._assignment_checks = True
@@ -477,7 +477,7 @@ class Runtime:
             return
         self._state = "closing"
         if self._assignment_checks:
-            from .msgs._classgen import disable_assignment_checks
+            from ..msgs._classgen import disable_assignment_checks
 
             disable_assignment_checks()
             self._assignment_checks = False
