@@ -53,7 +53,8 @@ class Runtime:
     Parameters
     ----------
     transport
-        ``"local"`` (one process) or a :class:`~aiorobot._core._transport.Transport`.
+        A registered transport name (``"local"``: one process; ``"zenoh"``) or a
+        :class:`~aiorobot._core._transport.Transport`.
     domain_id
         Separates graphs on a shared network (as ``ROS_DOMAIN_ID``).
     use_sim_time

@@ -12,12 +12,15 @@ endpoint come and go, and it takes part in the bus as ordinary endpoints:
 * it adds what it discovers to the graph.
 
 ``Node`` never talks to a transport directly, so a networked transport (zenoh)
-plugs in without changing it.
+plugs in without changing it. Transports are found by name in a registry
+(:func:`register_transport`): the core registers ``"local"``, and importing
+``aiorobot.transport`` registers ``"zenoh"``; the core never imports an implementation.
 """
 
 from __future__ import annotations
 
-import os
+import importlib
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -25,7 +28,7 @@ if TYPE_CHECKING:
     from ._graph import NodeInfo
     from ._node import Node
 
-__all__ = ["LocalTransport", "Transport", "make_transport"]
+__all__ = ["LocalTransport", "Transport", "make_transport", "register_transport", "transport_names"]
 
 
 class Transport:
@@ -71,21 +74,58 @@ class LocalTransport(Transport):
     name = "local"
 
 
-def make_transport(name: str, *, domain_id: int = 0, **options: Any) -> Transport:
-    """``"local"`` or ``"zenoh"``; ``options`` go to the zenoh transport (``config_file``, ``connect``, ``listen``).
+#: Transport name -> factory called as ``factory(domain_id=..., **options)``. The core registers
+#: only ``"local"``; a package that provides transports registers them when it is imported.
+_REGISTRY: dict[str, Callable[..., Transport]] = {}
+#: Packages imported, once, the first time a name is not registered: the built-in transports
+#: (``aiorobot.transport`` registers ``"zenoh"``). The core names the package, never an implementation.
+_PROVIDERS = ("aiorobot.transport",)
+_providers_loaded = False
 
-    For zenoh, ``ROS_DOMAIN_ID`` in the environment applies when ``domain_id`` is left at 0,
-    as in ROS 2.
+
+def register_transport(name: str, factory: Callable[..., Transport]) -> None:
+    """Make ``name`` usable as ``Runtime(transport=name)``, ``transport = name`` in a config file and ``--transport``.
+
+    ``factory(domain_id=..., **options)`` returns a new, unopened :class:`Transport`.
+    Registering a name twice with a different factory raises ``ValueError``.
     """
-    if name == "local":
-        return LocalTransport(domain_id=domain_id)
-    if name == "zenoh":
-        from ..transport import ZenohTransport
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"transport name: expected an identifier such as 'zenoh', found {name!r}")
+    if not callable(factory):
+        raise TypeError(f"transport {name!r}: expected a factory (a Transport subclass or function), found {factory!r}")
+    known = _REGISTRY.get(name)
+    if known is not None and known is not factory:
+        raise ValueError(f"transport {name!r} is already registered to {known!r}; pick another name")
+    _REGISTRY[name] = factory
 
-        if domain_id == 0 and os.environ.get("ROS_DOMAIN_ID", "").strip():
-            raw = os.environ["ROS_DOMAIN_ID"].strip()
-            if not raw.isdigit() or not 0 <= int(raw) <= 232:
-                raise ValueError(f"ROS_DOMAIN_ID: expected an int in 0..232, found {raw!r}")
-            domain_id = int(raw)
-        return ZenohTransport(domain_id=domain_id, **options)
-    raise ValueError(f"transport: expected 'local' or 'zenoh', found {name!r}")
+
+def transport_names() -> tuple[str, ...]:
+    """The names :func:`make_transport` accepts, the built-in transports' included."""
+    _load_providers()
+    return tuple(sorted(_REGISTRY))
+
+
+def _load_providers() -> None:
+    global _providers_loaded
+    if not _providers_loaded:
+        for package in _PROVIDERS:
+            importlib.import_module(package)
+        _providers_loaded = True
+
+
+def make_transport(name: str, *, domain_id: int = 0, **options: Any) -> Transport:
+    """A new transport by its registered name: ``"local"``, ``"zenoh"`` or one a package registered.
+
+    ``options`` go to the transport's factory (zenoh takes ``config_file``, ``connect``, ``listen``).
+    """
+    factory = _REGISTRY.get(name)
+    if factory is None:
+        _load_providers()
+        factory = _REGISTRY.get(name)
+    if factory is None:
+        names = ", ".join(repr(n) for n in sorted(_REGISTRY))
+        raise ValueError(f"transport: expected one of {names}, found {name!r}")
+    return factory(domain_id=domain_id, **options)
+
+
+register_transport("local", LocalTransport)
