@@ -31,7 +31,7 @@ from collections.abc import Callable
 from typing import Any, TypeVar
 
 from . import CallbackGroup, Client, Node, Publisher, QoSProfile, Runtime
-from ._pubsub import Endpoint, Tap
+from ._core._pubsub import Endpoint, Tap
 
 __all__ = [
     "ON_FAILURE",

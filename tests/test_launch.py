@@ -87,7 +87,7 @@ def test_the_core_and_the_transports_import_no_launch_module_and_runtime_says_wh
         "import aiorobot.transport\n"  # a transport's config errors are ConfigErrors too, from the core
         "loaded = sorted(m for m in sys.modules if m.startswith(('aiorobot.launch', 'aiorobot.bag', 'aiorobot.foxglove')))\n"
         "assert loaded == [], loaded\n"
-        "from aiorobot._runtime import Runtime\n"
+        "from aiorobot._core._runtime import Runtime\n"
         "try:\n"
         "    Runtime(config='graph.toml')\n"
         "except TypeError as err:\n"

@@ -18,8 +18,8 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from .._node import Node
-from .._qos import QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._qos import QoSProfile, ReliabilityPolicy
 from ..lowlevel import wait_until_ns
 from ._metadata import BagError
 from ._reader import BagReader

@@ -19,9 +19,9 @@ from pathlib import Path
 from dataclasses import dataclass
 from typing import Any
 
-from .._node import Node
-from .._pubsub import Endpoint, Publisher
-from .._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._pubsub import Endpoint, Publisher
+from .._core._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ..lowlevel import Tap, add_tap, remove_tap, watch_publishers
 from ._metadata import BagError
 from ._writer import CHUNK_SIZE, BagWriter

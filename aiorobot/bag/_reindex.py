@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._qos import QoSProfile
+from .._core._qos import QoSProfile
 from ._metadata import BagError, TopicInfo, qos_from_bag, write_metadata
 from ._writer import CHUNK_SIZE
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import IO, Any
 
-from .._qos import QoSProfile
+from .._core._qos import QoSProfile
 from ._metadata import BagError, TopicInfo, qos_yaml, write_metadata
 
 __all__ = ["BagWriter"]

@@ -79,7 +79,7 @@ def main(args: argparse.Namespace) -> int:
     from ._report import print_report
     from ._runner import python_argv, run_benchmark
 
-    from aiorobot._logging import setup_logging
+    from aiorobot._core._logging import setup_logging
 
     from ._progress import BenchProgress
 

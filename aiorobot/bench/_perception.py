@@ -71,7 +71,8 @@ def _pct(values: list[float], q: float) -> float:
 
 
 async def _transport(frames: int) -> dict[str, Any]:
-    from aiorobot import Node, Runtime, _offload
+    from aiorobot import Node, Runtime
+    from aiorobot._core import _offload
     from aiorobot.msgs.sensor_msgs import Image
     from aiorobot.perception import Pipeline
 

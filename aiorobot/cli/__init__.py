@@ -66,7 +66,7 @@ def _one_line_error(err: Exception) -> int | None:
     """A configuration error (exit 2) or a refused zenoh session (exit 1) that reached the top
     from any command, printed as its one line; None for anything else (a bug: the traceback stays).
     The session error is looked up only if its module was imported, so raising it imported it."""
-    from aiorobot._errors import ConfigError  # the core's exceptions: imports nothing else
+    from aiorobot._core._errors import ConfigError  # the core's exceptions: imports nothing else
 
     if isinstance(err, ConfigError):
         print(err, file=sys.stderr)

@@ -61,7 +61,7 @@ def run_script(
             file=sys.stderr,
         )
         return 2
-    from .._ros_args import RosArgsError, parse_ros_args
+    from .._core._ros_args import RosArgsError, parse_ros_args
     from ..compat import resolve_entry_point, run_entry_point, run_path
     from ..compat._context import settings
 

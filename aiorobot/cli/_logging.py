@@ -9,7 +9,7 @@ import logging
 import sys
 from typing import TextIO
 
-from aiorobot._logging import NodeFormatter, parse_level
+from aiorobot._core._logging import NodeFormatter, parse_level
 
 __all__ = ["configure_logging", "installed_handler"]
 
@@ -51,7 +51,7 @@ def configure_logging(level: str, stream: TextIO | None = None) -> logging.Handl
         handler = logging.StreamHandler(stream)
         handler.setFormatter(NodeFormatter())
     logger = logging.getLogger("aiorobot")
-    from aiorobot import _logging
+    from aiorobot._core import _logging
 
     if _logging._default_handler is not None:
         logger.removeHandler(_logging._default_handler)

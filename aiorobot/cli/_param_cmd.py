@@ -153,7 +153,7 @@ async def _list(rt: Any, node: Any, args: argparse.Namespace, regex: re.Pattern[
 
 
 async def _get(node: Any, fqn: str, args: argparse.Namespace) -> int:
-    from .._parameters import parameter_value_to_python
+    from .._core._parameter_types import parameter_value_to_python
 
     response = await _call(node, fqn, "get_parameters", args.timeout, names=[args.parameter_name])
     if not response.values:
@@ -169,7 +169,7 @@ async def _get(node: Any, fqn: str, args: argparse.Namespace) -> int:
 
 
 async def _set(node: Any, fqn: str, args: argparse.Namespace) -> int:
-    from .._parameters import get_parameter_value
+    from .._core._parameter_types import get_parameter_value
     from ..msgs.rcl_interfaces import Parameter
 
     value = get_parameter_value(args.value)
@@ -186,7 +186,7 @@ async def _set(node: Any, fqn: str, args: argparse.Namespace) -> int:
 async def _dump(node: Any, fqn: str, args: argparse.Namespace) -> int:
     import yaml
 
-    from .._parameters import parameter_value_to_python
+    from .._core._parameter_types import parameter_value_to_python
 
     listed = await _call(node, fqn, "list_parameters", args.timeout, prefixes=[], depth=0)
     names = sorted(listed.result.names)
@@ -233,7 +233,7 @@ def _read_file_for_check(path: str) -> Any:
 
 
 async def _load(node: Any, fqn: str, args: argparse.Namespace, loaded: Any) -> int:
-    from .._parameters import Parameter
+    from .._core._parameter_types import Parameter
 
     values: dict[str, Any] = {}
     for section in loaded.sections:  # later sections win, as when a node starts with the file

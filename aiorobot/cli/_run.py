@@ -193,7 +193,7 @@ async def _serve_process(
     for (node, _), node_config in zip(nodes, config.nodes):
         set_on_failure(node, "continue" if keep_going and node_config.on_failure == "stop" else node_config.on_failure)
     runtime_config = config.runtime
-    from aiorobot._transport import make_transport
+    from aiorobot._core._transport import make_transport
 
     options = runtime_options(config)  # the Runtime arguments set by the [runtime] table
     # a multi-process graph (no zenoh_config of its own): the processes meet at the supervisor's endpoint
@@ -224,7 +224,7 @@ async def _serve_process(
 
 def _outcome(rt: Runtime) -> int:
     """Print what went wrong during the run; 1 if a node failed to start or a callback raised."""
-    from aiorobot._watchdog import EXIT_SHUTDOWN_TIMEOUT
+    from aiorobot._core._watchdog import EXIT_SHUTDOWN_TIMEOUT
 
     stats = rt.statistics()
     lines = []

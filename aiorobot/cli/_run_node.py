@@ -1,7 +1,7 @@
 """``aiorobot run module:Class [--duration SEC] --ros-args ...``: one node, as ``ros2 run`` runs it.
 
 ``--ros-args`` takes ROS 2's arguments (``-p name:=value``, ``-r from:=to``, ``-r __node:=x``,
-``-r __ns:=/y``, ``--params-file f.yaml``, ``--log-level LEVEL``; see ``aiorobot._ros_args``).
+``-r __ns:=/y``, ``--params-file f.yaml``, ``--log-level LEVEL``; see ``aiorobot._core._ros_args``).
 The node class must accept ``**kwargs`` (they reach ``Node.__init__`` as ``cli_args``).
 Everything is checked before the runtime starts; a bad argument is one line and status 2.
 """
@@ -33,7 +33,7 @@ def run_node(args: argparse.Namespace) -> int:
     """Build the node from ``args.config`` (a ``module:Class``) and ``args.ros_args``; run it."""
     spec = str(args.config)
     ros_args = ["--ros-args", *(args.ros_args or [])]
-    from aiorobot._ros_args import RosArgsError
+    from aiorobot._core._ros_args import RosArgsError
 
     from ._logging import configure_logging
 
@@ -56,7 +56,7 @@ class _UsageError(Exception):
 
 
 def _log_level(ros_args: list[str]) -> str:
-    from aiorobot._ros_args import parse_ros_args
+    from aiorobot._core._ros_args import parse_ros_args
 
     return parse_ros_args(ros_args).log_level or "info"
 
@@ -65,7 +65,7 @@ def build_node(spec: str, cli_args: list[str]) -> Any:
     """Import ``spec`` and construct it with ``cli_args``; ``_UsageError`` with one line on any problem."""
     from aiorobot import Node, ParameterError
     from aiorobot.parameters import ParameterFileError
-    from aiorobot._ros_args import RosArgsError, parse_ros_args
+    from aiorobot._core._ros_args import RosArgsError, parse_ros_args
 
     try:
         parse_ros_args(cli_args)

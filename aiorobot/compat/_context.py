@@ -24,8 +24,8 @@ import weakref
 from collections.abc import Callable, Coroutine, Iterator
 from typing import Any, TypeVar
 
-from .._ros_args import RosArgs, parse_ros_args
-from .._runtime import Runtime
+from .._core._ros_args import RosArgs, parse_ros_args
+from .._core._runtime import Runtime
 from ..lowlevel import adopt_thread, stop_watching_stalls
 
 __all__ = ["Context", "ExternalShutdownException", "default_context", "settings"]

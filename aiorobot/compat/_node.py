@@ -10,11 +10,11 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from .. import _actions, _services
-from .._node import Node as _AioNode
-from .._event_handler import _EventCallbacks
-from .._qos import QoSProfile, to_qos_profile
-from .._timer import Rate as _AioRate
+from .._core import _actions, _services
+from .._core._node import Node as _AioNode
+from .._core._event_handler import _EventCallbacks
+from .._core._qos import QoSProfile, to_qos_profile
+from .._core._timer import Rate as _AioRate
 from ..lowlevel import add_client, node_loop
 from ._context import Context, default_context
 from ._dispatch import gate_callback, wrap_callback
@@ -57,7 +57,7 @@ class Client(_services.Client):
         return await _services.Client.call(self, request)
 
     def call_async(self, request: Any) -> Any:
-        from .._future import future_of
+        from .._core._future import future_of
 
         self._check_request(request)
         ctx = self._context

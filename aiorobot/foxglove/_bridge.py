@@ -20,10 +20,10 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
-from .._node import Node
-from .._pubsub import Endpoint, Publisher
+from .._core._node import Node
+from .._core._pubsub import Endpoint, Publisher
 from ..lowlevel import Tap, add_tap, node_loop, remove_tap, watch_publishers
-from .._qos import QoSProfile, ReliabilityPolicy
+from .._core._qos import QoSProfile, ReliabilityPolicy
 
 __all__ = ["FoxgloveBridge", "FoxgloveStatistics"]
 

@@ -11,7 +11,7 @@ behind ``Runtime(config=...)`` (``aiorobot.Runtime`` imports it for that).
 
 from __future__ import annotations
 
-from .._runtime import install_config_loader
+from .._core._runtime import install_config_loader
 from ._build import build_nodes
 from ._config import (
     MAIN_PROCESS,

@@ -17,7 +17,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from ._config import MAIN_PROCESS, ConfigError, GraphConfig, NodeConfig
-from .._errors import InvalidParameterValueError
+from .._core._errors import InvalidParameterValueError
 
 if TYPE_CHECKING:
     from aiorobot import Node

@@ -24,10 +24,10 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from .._errors import ConfigError, InvalidNameError
-from .._names import expand_name, validate_namespace, validate_node_name
-from .._runtime import EXECUTORS, PRIORITY_STALL_THRESHOLD_SEC, SHUTDOWN_TIMEOUT_SEC, STALL_THRESHOLD_SEC
-from .._transport import MAX_DOMAIN_ID
+from .._core._errors import ConfigError, InvalidNameError
+from .._core._names import expand_name, validate_namespace, validate_node_name
+from .._core._runtime import EXECUTORS, PRIORITY_STALL_THRESHOLD_SEC, SHUTDOWN_TIMEOUT_SEC, STALL_THRESHOLD_SEC
+from .._core._transport import MAX_DOMAIN_ID
 
 __all__ = [
     "EXECUTORS",

@@ -11,8 +11,8 @@ import os
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
-from .._runtime import Runtime
-from .._transport import make_transport
+from .._core._runtime import Runtime
+from .._core._transport import make_transport
 from ._build import build_nodes
 from ._config import GraphConfig, load_config
 
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from .._node import Node
+    from .._core._node import Node
 
 __all__ = ["config_loader", "open_runtime", "runtime_options"]
 

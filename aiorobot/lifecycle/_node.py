@@ -7,9 +7,9 @@ import inspect
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from .._groups import ReentrantCallbackGroup
-from .._node import Node
-from .._qos import QoSProfile
+from .._core._groups import ReentrantCallbackGroup
+from .._core._node import Node
+from .._core._qos import QoSProfile
 from ._publisher import LifecyclePublisher
 from ._state_machine import (
     STATES,

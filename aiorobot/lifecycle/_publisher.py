@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Generic, TypeVar
 
 if TYPE_CHECKING:
-    from .._pubsub import Publisher
+    from .._core._pubsub import Publisher
     from ._node import LifecycleNode
 
 __all__ = ["LifecyclePublisher"]

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 from ._state_machine import InvalidTransitionError, TransitionCallbackReturn
 
 if TYPE_CHECKING:
-    from .._groups import CallbackGroup
+    from .._core._groups import CallbackGroup
     from ._node import LifecycleNode
 
 __all__ = ["create_lifecycle_services"]

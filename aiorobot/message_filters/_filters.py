@@ -9,13 +9,13 @@ import logging
 from collections.abc import Awaitable, Callable, Coroutine, Generator
 from typing import TYPE_CHECKING, Any
 
-from .._qos import QoSProfile
-from .._time import Time
+from .._core._qos import QoSProfile
+from .._core._time import Time
 
 if TYPE_CHECKING:
-    from .._groups import CallbackGroup
-    from .._node import Node
-    from .._pubsub import Subscription
+    from .._core._groups import CallbackGroup
+    from .._core._node import Node
+    from .._core._pubsub import Subscription
 
 __all__ = ["DONE", "Cache", "Connection", "SimpleFilter", "Subscriber", "stamp_ns_of"]
 

@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from .._node import Node
-from .._warm_up import compile_kernels
-from .._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._warm_up import compile_kernels
+from .._core._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ._amcl import Amcl, AmclParameters
 from ._geometry import transform_to_xyyaw, xyyaw, yaw_quaternion
 from ._map_server import MAP_QOS
@@ -61,7 +61,7 @@ class AmclNode(Node):
         self.filter: Amcl | None = None
         self.updates = 0
         self.create_subscription(OccupancyGrid, "/map", self._on_map, MAP_QOS)
-        from .._groups import MutuallyExclusiveCallbackGroup
+        from .._core._groups import MutuallyExclusiveCallbackGroup
 
         # Its own group: a scan waiting for its transform must not hold up the tf listener's callbacks.
         self.create_subscription(LaserScan, scan_topic if scan_topic.startswith("/") else f"/{scan_topic}", self._on_scan,

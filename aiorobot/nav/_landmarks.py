@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._node import Node
+from .._core._node import Node
 
 __all__ = ["LandmarkFixNode", "base_pose_from_marker", "base_pose_from_markers", "map_from_marker"]
 

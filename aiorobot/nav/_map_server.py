@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .._node import Node
-from .._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ._maps import load_map
 
 __all__ = ["MAP_QOS", "MapServer"]

@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._node import Node
-from .._warm_up import compile_kernels
-from .._qos import QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._warm_up import compile_kernels
+from .._core._qos import QoSProfile, ReliabilityPolicy
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
 

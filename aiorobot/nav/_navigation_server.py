@@ -30,9 +30,9 @@ from typing import Any
 
 import numpy as np
 
-from .._node import Node
-from .._warm_up import compile_kernels
-from .._qos import QoSProfile, ReliabilityPolicy
+from .._core._node import Node
+from .._core._warm_up import compile_kernels
+from .._core._qos import QoSProfile, ReliabilityPolicy
 from ._costmap import Costmap
 from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS

@@ -20,7 +20,7 @@ import asyncio
 import enum
 from typing import Any
 
-from .._node import Node
+from .._core._node import Node
 
 __all__ = ["Navigator", "TaskResult"]
 

@@ -180,7 +180,7 @@ def parameter_dict_from_yaml_file(
     Loads every node's section when ``target_nodes`` is empty (``/**`` only with
     ``use_wildcard``); ``RuntimeError`` when a target node is not in the file.
     """
-    from .._parameters import Parameter
+    from .._core._parameter_types import Parameter
 
     loaded = load_parameter_file(parameter_file)
     patterns = [s.pattern for s in loaded.sections]

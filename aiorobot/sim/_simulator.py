@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from aiorobot import Node, Parameter, QoSProfile, compile_kernels
-from aiorobot._qos import DurabilityPolicy
+from aiorobot._core._qos import DurabilityPolicy
 
 from ._camera import CameraModel, MarkerRenderer, camera_pose_matrix
 from ._messages import occupancy_grid_message, odometry_message, static_transform

@@ -17,7 +17,7 @@ except ImportError:  # pragma: no cover - the fixtures need pytest-asyncio
     pytest_asyncio = None  # type: ignore[assignment]
 
 if pytest_asyncio is not None:
-    from .._runtime import Runtime
+    from .._core._runtime import Runtime
     from ._sim import SimClock
 
     @pytest_asyncio.fixture

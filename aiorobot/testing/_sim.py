@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from .._clock_publisher import ClockPublisher
-from .._runtime import Runtime
-from .._time import Duration
+from .._core._clock_publisher import ClockPublisher
+from .._core._runtime import Runtime
+from .._core._time import Duration
 
 __all__ = ["ClockPublisher", "SimClock"]
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from aiorobot._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from aiorobot._core._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 __all__ = [
     "DYNAMIC_QOS",

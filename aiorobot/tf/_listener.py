@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from aiorobot._qos import QoSProfile
+from aiorobot._core._qos import QoSProfile
 
 from ._broadcasters import DYNAMIC_QOS, STATIC_QOS
 from ._buffer_core import BufferCore

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from aiorobot._time import Time
+from aiorobot._core._time import Time
 
 from ._math import Quat, Vec
 

@@ -18,9 +18,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from aiorobot._node import Node
-from aiorobot._parameters import Parameter, SetParametersResult
-from aiorobot._qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
+from aiorobot._core._node import Node
+from aiorobot._core._parameter_types import Parameter, SetParametersResult
+from aiorobot._core._qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
 
 from ._broadcasters import StaticTransformBroadcaster, TransformBroadcaster
 from ._msgs import make_transform_stamped, time_ns

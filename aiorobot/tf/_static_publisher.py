@@ -20,8 +20,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from aiorobot._node import Node
-from aiorobot._parameters import ParameterDescriptor
+from aiorobot._core._node import Node
+from aiorobot._core._parameter_types import ParameterDescriptor
 
 from ._broadcasters import StaticTransformBroadcaster
 from ._math import quaternion_from_euler

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._errors import ConfigError
+from .._core._errors import ConfigError
 
 __all__ = [
     "ALLOW_PLAIN_ENV",

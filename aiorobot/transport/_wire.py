@@ -11,7 +11,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
-from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 __all__ = [
     "ATTACHMENT_SIZE",

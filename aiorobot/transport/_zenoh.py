@@ -33,11 +33,11 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from .._pubsub import Publisher, Subscription, Tap
-from .._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from .._services import Client, Service, _Call, _reply
-from .._errors import ServiceError
-from .._transport import Transport
+from .._core._pubsub import Publisher, Subscription, Tap
+from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from .._core._services import Client, Service, _Call, _reply
+from .._core._errors import ServiceError
+from .._core._transport import Transport
 from ._diagnose import NOTHING_LISTENS, host_port, why_unreachable
 from ._session_config import (
     SessionPlan,
@@ -62,9 +62,9 @@ from ._wire import (
 )
 
 if TYPE_CHECKING:
-    from .._bus import Bus
-    from .._graph import NodeInfo
-    from .._node import Node
+    from .._core._bus import Bus
+    from .._core._graph import NodeInfo
+    from .._core._node import Node
 
 __all__ = ["TransportStatistics", "ZenohTransport", "build_session_config"]
 
@@ -898,7 +898,7 @@ class ZenohTransport(Transport):
                 self._warn("token", f"could not add remote {info.kind} {info.topic or info.node}: {err}")
 
     def _learn(self, info: Any) -> None:
-        from .._graph import NodeInfo
+        from .._core._graph import NodeInfo
         from ..msgs import get
 
         bus = self.bus

@@ -6,7 +6,7 @@ import re
 import xml.etree.ElementTree as ET
 
 from aiorobot import EndpointInfo, Graph, NodeInfo, QoSProfile, TopicInfo
-from aiorobot._bus import Incompatibility
+from aiorobot._core._bus import Incompatibility
 from aiorobot.cli._graph_html import graph_html, layout
 
 SVG = "{http://www.w3.org/2000/svg}"

@@ -6,7 +6,7 @@ import threading
 import pytest
 
 from aiorobot import Future
-from aiorobot._future import future_of
+from aiorobot._core._future import future_of
 
 
 def test_cancelled():

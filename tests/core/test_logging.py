@@ -6,7 +6,7 @@ import logging
 import pytest
 
 from aiorobot import Node
-from aiorobot._logging import NodeFormatter, parse_level, setup_logging
+from aiorobot._core._logging import NodeFormatter, parse_level, setup_logging
 
 
 async def test_records_carry_node_name_and_sim_time(sim_runtime, sim_clock, caplog):

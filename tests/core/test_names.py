@@ -1,7 +1,7 @@
 import pytest
 
 from aiorobot import InvalidNameError, Node
-from aiorobot._names import expand_name, resolve_name, validate_namespace
+from aiorobot._core._names import expand_name, resolve_name, validate_namespace
 
 
 @pytest.mark.parametrize(

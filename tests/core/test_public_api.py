@@ -44,3 +44,25 @@ def test_import_aiorobot_is_light_and_names_load_on_use():
         "assert aiorobot.msgs.get('geometry_msgs/msg/Twist').__msgtype__ == 'geometry_msgs/msg/Twist'\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+
+
+def test_one_list_of_public_names_and_the_type_checking_imports_agree_with_it():
+    """``_EXPORTS`` is the list; ``__all__`` is derived from it and the TYPE_CHECKING imports restate it."""
+    import ast
+    import importlib
+    from pathlib import Path
+
+    assert aiorobot.__all__ == sorted(aiorobot._EXPORTS, key=str.lower)
+    tree = ast.parse(Path(aiorobot.__file__).read_text())
+    blocks = [n for n in tree.body if isinstance(n, ast.If) and getattr(n.test, "id", None) == "TYPE_CHECKING"]
+    assert len(blocks) == 1
+    typed = {}
+    for stmt in blocks[0].body:
+        assert isinstance(stmt, ast.ImportFrom) and stmt.level == 1, ast.dump(stmt)
+        for alias in stmt.names:
+            assert alias.asname is None, alias.name
+            assert alias.name not in typed, f"{alias.name} imported twice"
+            typed[alias.name] = stmt.module
+    assert typed == aiorobot._EXPORTS
+    for name, module in aiorobot._EXPORTS.items():
+        assert hasattr(importlib.import_module(f"aiorobot.{module}"), name), f"aiorobot.{module}.{name}"

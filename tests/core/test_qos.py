@@ -13,7 +13,7 @@ from aiorobot import (
     qos_profile_sensor_data,
     qos_profile_system_default,
 )
-from aiorobot._qos import incompatibility, to_qos_profile
+from aiorobot._core._qos import incompatibility, to_qos_profile
 from aiorobot.msgs.std_msgs import Int32
 from aiorobot.testing import settle
 
@@ -140,7 +140,7 @@ def test_liveliness_policy_and_lease():
 
 def test_zero_and_infinite_durations_mean_no_limit():
     from aiorobot import Infinite
-    from aiorobot._qos import finite_ns
+    from aiorobot._core._qos import finite_ns
 
     assert finite_ns(None) is None and finite_ns(Duration()) is None and finite_ns(Infinite) is None
     assert finite_ns(Duration(seconds=2)) == 2_000_000_000

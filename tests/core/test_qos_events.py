@@ -321,7 +321,7 @@ async def test_a_remote_endpoint_matches_and_unmatches_as_it_joins_and_leaves_th
     # what the zenoh transport does for a remote subscription (tests/transport/test_peers.py runs it on
     # zenoh): a Tap named after the remote node joins the bus, and leaves it when the peer goes; its
     # hidden sender tap is nobody's peer
-    from aiorobot._pubsub import Tap
+    from aiorobot._core._pubsub import Tap
 
     node = runtime.add_node(Node("n"))
     got, cb = recorder()

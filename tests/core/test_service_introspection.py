@@ -3,7 +3,7 @@
 import pytest
 
 from aiorobot import Node
-from aiorobot._service_introspection import ServiceIntrospectionState
+from aiorobot._core._service_introspection import ServiceIntrospectionState
 from aiorobot.msgs.example_interfaces import AddTwoInts
 from aiorobot.testing import settle
 

@@ -6,7 +6,7 @@ import threading
 import pytest
 
 from aiorobot import Future, MutuallyExclusiveCallbackGroup, Node, ServiceError, ServiceUnavailableError
-from aiorobot._services import takes_response
+from aiorobot._core._services import takes_response
 from aiorobot.msgs.example_interfaces import AddTwoInts
 from aiorobot.msgs.rcl_interfaces import GetParameters
 from aiorobot.msgs.std_srvs import Trigger

@@ -6,7 +6,7 @@ import logging
 import pytest
 
 from aiorobot import MutuallyExclusiveCallbackGroup, Node, ReentrantCallbackGroup
-from aiorobot._timer import _percentile
+from aiorobot._core._timer import _percentile
 
 
 class Ticker(Node):

@@ -13,7 +13,7 @@ import textwrap
 import pytest
 
 from aiorobot import InvalidParameterTypeError, Node, Parameter
-from aiorobot._ros_args import RosArgsError, parse_ros_args
+from aiorobot._core._ros_args import RosArgsError, parse_ros_args
 from aiorobot.parameters import ParameterFileError, load_parameter_file
 from aiorobot.parameters._rcl_yaml import rcl_scalar
 

@@ -10,7 +10,7 @@ import textwrap
 import pytest
 
 from aiorobot import Node
-from aiorobot._ros_args import RosArgsError, parse_ros_args, strip_ros_args
+from aiorobot._core._ros_args import RosArgsError, parse_ros_args, strip_ros_args
 
 
 def test_parameters_remaps_files_and_levels():

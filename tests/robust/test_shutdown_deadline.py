@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 
-from aiorobot._watchdog import EXIT_SHUTDOWN_TIMEOUT
+from aiorobot._core._watchdog import EXIT_SHUTDOWN_TIMEOUT
 
 from ._proc import FirmwareThread, interrupt, start, wait_for_line, write_graph
 

@@ -10,7 +10,7 @@ import threading
 
 import pytest
 
-from aiorobot._watchdog import Watchdog
+from aiorobot._core._watchdog import Watchdog
 
 
 @pytest.mark.timeout(60)

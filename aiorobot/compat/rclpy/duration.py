@@ -1,5 +1,5 @@
 """``rclpy.duration``."""
 
-from ..._time import Duration, Infinite
+from ..._core._time import Duration, Infinite
 
 __all__ = ["Duration", "Infinite"]

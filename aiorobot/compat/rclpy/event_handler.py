@@ -1,4 +1,4 @@
-"""``rclpy.event_handler``: QoS event callbacks, over aiorobot._event_handler.
+"""``rclpy.event_handler``: QoS event callbacks, over aiorobot._core._event_handler.
 
 The callbacks given here are the program's: the compat node runs them as it runs the
 program's other callbacks (in the spinning thread, under the entity's callback group),
@@ -16,8 +16,8 @@ import enum
 from collections.abc import Callable
 from typing import Any
 
-from ... import _event_handler as _eh
-from ..._event_handler import (
+from ..._core import _event_handler as _eh
+from ..._core._event_handler import (
     EventHandler,
     IncompatibleTypeInfo,
     QoSLivelinessChangedInfo,

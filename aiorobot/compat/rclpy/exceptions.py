@@ -1,6 +1,6 @@
 """``rclpy.exceptions``."""
 
-from ..._errors import (
+from ..._core._errors import (
     InvalidParameterValueError as InvalidParameterValueException,
     ParameterAlreadyDeclaredError as ParameterAlreadyDeclaredException,
     ParameterImmutableError as ParameterImmutableException,

@@ -7,7 +7,7 @@ import os
 from collections.abc import Callable
 from typing import Any
 
-from ..._future import Future
+from ..._core._future import Future
 from .._context import Context, ExternalShutdownException, default_context
 from .._missing import module_getattr
 

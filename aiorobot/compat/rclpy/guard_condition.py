@@ -14,7 +14,7 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from ..._groups import CallbackGroup
+from ..._core._groups import CallbackGroup
 from ...lowlevel import node_loop, run_callback
 from .._context import Context, default_context
 from .._dispatch import wrap_callback

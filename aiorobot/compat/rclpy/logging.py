@@ -9,7 +9,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from ..._logging import NodeLogger
+from ..._core._logging import NodeLogger
 from .impl.logging_severity import LoggingSeverity
 
 __all__ = [

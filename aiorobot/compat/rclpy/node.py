@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..._node import Node as _AioNode
+from ..._core._node import Node as _AioNode
 from .._missing import module_getattr
 from .._node import make_node_class
 

@@ -1,6 +1,6 @@
 """``rclpy.parameter``: ``Parameter``, its type, and rclpy's conversion helpers."""
 
-from ..._parameters import Parameter, ParameterType, get_parameter_value, parameter_value_to_python
+from ..._core._parameter_types import Parameter, ParameterType, get_parameter_value, parameter_value_to_python
 from ...parameters._files import parameter_dict_from_yaml_file
 
 __all__ = [

@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ...msgs import rcl_interfaces as _ri
-from ..._parameters import Parameter
+from ..._core._parameter_types import Parameter
 from ...parameters._files import parameter_dict_from_yaml_file
 from .qos import qos_profile_parameter_events, qos_profile_services_default
 

@@ -1,5 +1,5 @@
 """``rclpy.publisher``."""
 
-from ..._pubsub import Publisher
+from ..._core._pubsub import Publisher
 
 __all__ = ["Publisher"]

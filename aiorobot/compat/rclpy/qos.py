@@ -11,8 +11,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from ... import _qos
-from ..._qos import (
+from ..._core import _qos
+from ..._core._qos import (
     DurabilityPolicy,
     HistoryPolicy,
     LivelinessPolicy,

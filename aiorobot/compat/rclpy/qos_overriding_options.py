@@ -17,10 +17,10 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from typing import Any
 
-from ... import _qos
+from ..._core import _qos
 from ...msgs import rcl_interfaces as _ri
-from ..._errors import ParameterAlreadyDeclaredError
-from ..._time import Duration
+from ..._core._errors import ParameterAlreadyDeclaredError
+from ..._core._time import Duration
 from .._missing import not_provided
 from .qos import QoSPolicyKind, QoSProfile, frozen
 

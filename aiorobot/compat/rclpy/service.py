@@ -1,5 +1,5 @@
 """``rclpy.service``."""
 
-from ..._services import Service
+from ..._core._services import Service
 
 __all__ = ["Service"]

@@ -1,5 +1,5 @@
 """``rclpy.service_introspection``: the states ``configure_introspection`` takes."""
 
-from ..._service_introspection import ServiceIntrospectionState
+from ..._core._service_introspection import ServiceIntrospectionState
 
 __all__ = ["ServiceIntrospectionState"]

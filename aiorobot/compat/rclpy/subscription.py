@@ -1,5 +1,5 @@
 """``rclpy.subscription``."""
 
-from ..._pubsub import Subscription
+from ..._core._pubsub import Subscription
 
 __all__ = ["Subscription"]

@@ -1,6 +1,6 @@
 """``rclpy.task``: aiorobot's rclpy-style :class:`~aiorobot.Future` (thread-safe)."""
 
-from ..._future import Future
+from ..._core._future import Future
 
 __all__ = ["Future", "Task"]
 

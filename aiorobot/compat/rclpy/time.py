@@ -1,5 +1,5 @@
 """``rclpy.time``."""
 
-from ..._time import Time
+from ..._core._time import Time
 
 __all__ = ["Time"]

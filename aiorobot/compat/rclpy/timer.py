@@ -1,6 +1,6 @@
 """``rclpy.timer``."""
 
-from ..._timer import Timer, TimerInfo
+from ..._core._timer import Timer, TimerInfo
 from .._node import Rate
 
 __all__ = ["Rate", "Timer", "TimerInfo"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
-from ..._ros_args import strip_ros_args
+from ..._core._ros_args import strip_ros_args
 from . import ok, shutdown, try_shutdown
 
 __all__ = ["ok", "remove_ros_args", "shutdown", "try_shutdown"]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..._groups import ReentrantCallbackGroup
-from ..._qos import QoSProfile
+from ..._core._groups import ReentrantCallbackGroup
+from ..._core._qos import QoSProfile
 from .._node import raw
 
 __all__ = ["wait_for_message"]

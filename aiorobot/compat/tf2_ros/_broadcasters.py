@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ... import tf as _tf
-from ..._qos import DurabilityPolicy, HistoryPolicy, QoSProfile
+from ..._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
 __all__ = ["StaticTransformBroadcaster", "TransformBroadcaster"]
 

@@ -13,8 +13,8 @@ from collections.abc import Callable
 from typing import Any
 
 from ... import tf as _tf
-from ..._future import Future
-from ..._time import Duration
+from ..._core._future import Future
+from ..._core._time import Duration
 from ...tf._buffer import _timeout_seconds
 from ...tf._buffer_core import DEFAULT_CACHE_TIME_SEC
 from ...tf._msgs import time_ns
@@ -108,11 +108,11 @@ class Buffer(_CoreNames, _tf.Buffer, BufferInterface):
         if node is not None:
             self.clock = node.get_clock()
         else:
-            from ..._clock import Clock
+            from ..._core._clock import Clock
 
             self.clock = Clock()
         # as tf2_ros: a jump back in time (a bag looping, sim time restarting) clears the buffer
-        from ..._clock import JumpThreshold
+        from ..._core._clock import JumpThreshold
 
         threshold = JumpThreshold(min_forward=None, min_backward=Duration(seconds=-1), on_clock_change=True)
         self.jump_handle = self.clock.create_jump_callback(threshold, post_callback=self.time_jump_callback)

@@ -10,7 +10,7 @@ import copy
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-from ..._time import Duration
+from ..._core._time import Duration
 
 __all__ = [
     "BufferInterface",

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..._groups import ReentrantCallbackGroup
-from ..._qos import DurabilityPolicy, HistoryPolicy, QoSProfile
+from ..._core._groups import ReentrantCallbackGroup
+from ..._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile
 
 __all__ = ["DEFAULT_STATIC_TF_TOPIC", "DEFAULT_TF_TOPIC", "TransformListener"]
 

@@ -6,8 +6,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from .... import _actions
-from ...._actions import CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
+from ...._core import _actions
+from ...._core._actions import CancelResponse, ClientGoalHandle, GoalResponse, GoalStatus, ServerGoalHandle
 from ..._missing import module_getattr
 from ..._node import raw
 
@@ -76,7 +76,7 @@ class ActionClient(_actions.ActionClient):
 
     def send_goal_async(self, goal: Any, feedback_callback: Any = None, goal_uuid: Any = None) -> Any:
         ctx = self.node._context
-        from ...._future import future_of
+        from ...._core._future import future_of
 
         if not isinstance(goal, self.action_type.Goal):
             raise TypeError(f"send_goal_async expects {self.action_type.Goal.__msgtype__}, got {type(goal).__name__}")

@@ -6,10 +6,10 @@ entity types an AsyncNode makes (aiorobot's); ``EventsExecutor`` is not provided
 
 from __future__ import annotations
 
-from ...._pubsub import Publisher as AsyncPublisher
-from ...._pubsub import Subscription as AsyncSubscription
-from ...._services import Service as AsyncService
-from ...._timer import Timer as AsyncTimer
+from ...._core._pubsub import Publisher as AsyncPublisher
+from ...._core._pubsub import Subscription as AsyncSubscription
+from ...._core._services import Service as AsyncService
+from ...._core._timer import Timer as AsyncTimer
 from ..._missing import module_getattr
 from .async_node import AsyncClient, AsyncClock, AsyncNode
 

@@ -23,10 +23,10 @@ import functools
 from collections.abc import Callable
 from typing import Any
 
-from .... import _services
-from ...._groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from ...._core import _services
+from ...._core._groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ..._context import Context
-from ...._node import Node as _AioNode
+from ...._core._node import Node as _AioNode
 from ....lowlevel import add_client
 from ..node import Node
 from ._driver import call_user, driver_of, start_on

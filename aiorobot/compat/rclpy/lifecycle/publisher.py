@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Generic, TypeVar
 
-from ...._pubsub import Publisher
+from ...._core._pubsub import Publisher
 from .managed_entity import SimpleManagedEntity
 
 __all__ = ["LifecyclePublisher"]

@@ -19,7 +19,7 @@ class ClockPublisher(Node):
 
     def __init__(self, name: str = "sim_clock", **kw: Any) -> None:
         super().__init__(name, **kw)
-        from .msgs.rosgraph_msgs import Clock
+        from ..msgs.rosgraph_msgs import Clock
 
         self._msg_type = Clock
         self._pub = self.create_publisher(Clock, "/clock", QoSProfile(depth=1))

@@ -16,7 +16,7 @@ default: read-only arrays and sequences. Scalar fields and nested messages of a
 received message can still be assigned; with ``Runtime(debug_messages=True)``
 subscribers get a read-only twin instead, whose every assignment raises
 ``ReadOnlyMessageError`` naming the topic (and the deeper checks of
-``aiorobot._mutation`` run).
+``aiorobot._core._mutation`` run).
 A subscription owns a queue bounded by its QoS history (KEEP_LAST drops the
 oldest when full) and one dispatcher task on its node's loop; messages from
 another loop arrive through ``call_soon_threadsafe``.
@@ -33,7 +33,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from ._mutation import PublishGuard, digest
-from .msgs._classgen import freezer
+from ..msgs._classgen import freezer
 from ._event_handler import Lease, PublisherEventCallbacks, SubscriptionEventCallbacks
 from ._qos import DurabilityPolicy, LivelinessPolicy, QoSProfile, finite_ns
 
@@ -648,7 +648,7 @@ def _with_info(callback: Callable[..., Any]) -> Callable[[tuple[Any, Any]], Any]
 
 def _raw(callback: Callable[..., Any]) -> Callable[..., Any]:
     """``create_subscription(raw=True)``: the callback gets the message's CDR bytes, as rclpy's."""
-    from .msgs import serialize
+    from ..msgs import serialize
 
     def raw(msg: Any, *info: Any) -> Any:
         return callback(serialize(msg), *info)

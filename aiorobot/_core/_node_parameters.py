@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
-from .parameters._store import OnSetCallback, ParameterStore, PostSetCallback, PreSetCallback
-from ._parameters import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
+from ..parameters._store import OnSetCallback, ParameterStore, PostSetCallback, PreSetCallback
+from ._parameter_types import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
 
 __all__ = ["NodeParametersMixin"]
 
@@ -18,7 +18,7 @@ class NodeParametersMixin:
 
     def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
         """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
-        from .parameters._services import ParameterEventPublisher, create_parameter_services
+        from ..parameters._services import ParameterEventPublisher, create_parameter_services
         from ._time_source import TimeSource
 
         self._parameters.event_hook = ParameterEventPublisher(self)  # type: ignore[arg-type]
@@ -138,7 +138,7 @@ class NodeParametersMixin:
 
         rclpy difference: both arguments are optional (no arguments lists every parameter).
         """
-        from .msgs.rcl_interfaces import ListParametersResult
+        from ..msgs.rcl_interfaces import ListParametersResult
 
         names, prefixes_found = self._parameters.list([] if prefixes is None else prefixes, depth)
         return ListParametersResult(names=names, prefixes=prefixes_found)

@@ -1,7 +1,7 @@
 """``Runtime(debug_messages=True)``: checks of the zero-copy contract.
 
 ``publish`` hands subscribers one copy whose large arrays are shared read-only
-with the publisher (see ``aiorobot._pubsub``); with debug checks on that copy is
+with the publisher (see ``aiorobot._core._pubsub``); with debug checks on that copy is
 a read-only twin (every assignment raises). What the flags cannot stop is a
 write through another view of a shared buffer (a driver refilling the frame an
 Image's data is a view of) or a callback that sets an array writeable again. So

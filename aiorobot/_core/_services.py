@@ -132,7 +132,7 @@ class _ServiceEndpoint:
 
     def configure_introspection(self, clock: Any, service_event_pub_qos: Any, introspection_state: Any) -> None:
         """Publish this endpoint's calls on ``<service>/_service_event`` (rclpy's; see
-        :mod:`aiorobot._service_introspection`): ``ServiceIntrospectionState`` OFF, METADATA or CONTENTS."""
+        :mod:`aiorobot._core._service_introspection`): ``ServiceIntrospectionState`` OFF, METADATA or CONTENTS."""
         if self._introspection is None:
             self._introspection = ServiceIntrospection(self)
         self._introspection.configure(clock, service_event_pub_qos, introspection_state)

@@ -1,6 +1,6 @@
 """Service introspection, as rcl's: events of a service or client on ``<service>/_service_event``.
 
-``configure_introspection(clock, qos, state)`` on a :class:`~aiorobot._services.Service` or
+``configure_introspection(clock, qos, state)`` on a :class:`~aiorobot._core._services.Service` or
 ``Client`` turns it on: each call then publishes ``<Srv>_Event`` messages
 (``service_msgs/ServiceEventInfo info``, ``request[<=1]``, ``response[<=1]``) — REQUEST_SENT and
 RESPONSE_RECEIVED from the client, REQUEST_RECEIVED and RESPONSE_SENT from the service, all
@@ -66,7 +66,7 @@ class ServiceIntrospection:
         publisher = self._publisher
         if publisher is None or self.state is ServiceIntrospectionState.OFF:
             return
-        from .msgs.service_msgs import ServiceEventInfo
+        from ..msgs.service_msgs import ServiceEventInfo
 
         event = self.endpoint.srv_type.Event()
         event.info = ServiceEventInfo(

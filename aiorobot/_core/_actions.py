@@ -177,8 +177,8 @@ class ServerGoalHandle:
         self._transition(GoalStatus.CANCELED, (GoalStatus.CANCELING,))
 
     def _status_msg(self) -> Any:
-        from .msgs.action_msgs import GoalInfo
-        from .msgs.action_msgs import GoalStatus as GoalStatusMsg
+        from ..msgs.action_msgs import GoalInfo
+        from ..msgs.action_msgs import GoalStatus as GoalStatusMsg
 
         return GoalStatusMsg(goal_info=GoalInfo(goal_id=self.goal_id, stamp=self.stamp), status=int(self._status))
 
@@ -228,7 +228,7 @@ class ActionServer:
             raise TypeError(f"handle_accepted_callback must be callable, got {handle_accepted_callback!r}")
         if isinstance(result_timeout, bool) or not isinstance(result_timeout, (int, float)) or not result_timeout >= 0:
             raise ValueError(f"result_timeout: expected a number of seconds >= 0, got {result_timeout!r}")
-        from .msgs.action_msgs import CancelGoal, GoalStatusArray
+        from ..msgs.action_msgs import CancelGoal, GoalStatusArray
 
         self.node = node
         self.action_type = action_type
@@ -392,7 +392,7 @@ class ActionServer:
         return self.action_type.GetResult.Response(status=int(handle._status), result=handle._result)
 
     async def _on_cancel_goal(self, request: Any) -> Any:
-        from .msgs.action_msgs import CancelGoal
+        from ..msgs.action_msgs import CancelGoal
 
         info = request.goal_info
         gid = _gid(info.goal_id)
@@ -429,7 +429,7 @@ class ActionServer:
                 canceling.append(handle)
         if not canceling:
             return CancelGoal.Response(return_code=_ERROR_REJECTED)
-        from .msgs.action_msgs import GoalInfo
+        from ..msgs.action_msgs import GoalInfo
 
         return CancelGoal.Response(
             return_code=_ERROR_NONE,
@@ -523,7 +523,7 @@ class ClientGoalHandle:
         return future_of(self._cancel_response(None), self._client._loop_for_futures())
 
     async def _cancel_response(self, timeout_sec: float | None) -> Any:
-        from .msgs.action_msgs import CancelGoal, GoalInfo
+        from ..msgs.action_msgs import CancelGoal, GoalInfo
 
         return await self._client._cancel_goal.call(
             CancelGoal.Request(goal_info=GoalInfo(goal_id=self.goal_id)), timeout_sec
@@ -555,7 +555,7 @@ class ActionClient:
     def __init__(self, node: Node, action_type: Any, name: str, *, callback_group: CallbackGroup | None = None) -> None:
         _check_action_type(action_type)
         self.callback_group = callback_group
-        from .msgs.action_msgs import CancelGoal, GoalStatusArray
+        from ..msgs.action_msgs import CancelGoal, GoalStatusArray
 
         self.node = node
         self.action_type = action_type
@@ -649,7 +649,7 @@ class ActionClient:
         own (in a reentrant group), so a slow callback never delays the goal's status,
         result or the next feedback; rclpy runs it in the action client's callback group.
         """
-        from .msgs.unique_identifier_msgs import UUID
+        from ..msgs.unique_identifier_msgs import UUID
 
         action = self.action_type
         if not isinstance(goal, action.Goal):

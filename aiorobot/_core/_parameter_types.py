@@ -188,7 +188,7 @@ class Parameter:
 
     def to_parameter_msg(self) -> Any:
         """This parameter as an ``rcl_interfaces/msg/Parameter``."""
-        from .msgs.rcl_interfaces import Parameter as ParameterMsg
+        from ..msgs.rcl_interfaces import Parameter as ParameterMsg
 
         return ParameterMsg(name=self._name, value=self.get_parameter_value())
 
@@ -214,7 +214,7 @@ _FIELDS = {
 
 def to_parameter_value(ptype: ParameterType, value: Any) -> Any:
     """``value`` of ``ptype`` as an ``rcl_interfaces/msg/ParameterValue``."""
-    from .msgs.rcl_interfaces import ParameterValue
+    from ..msgs.rcl_interfaces import ParameterValue
 
     if ptype is ParameterType.NOT_SET:
         return ParameterValue(type=0)
@@ -343,7 +343,7 @@ class ParameterDescriptor:
 
     def to_msg(self) -> Any:
         """As an ``rcl_interfaces/msg/ParameterDescriptor``."""
-        from .msgs import rcl_interfaces as ri
+        from ..msgs import rcl_interfaces as ri
 
         return ri.ParameterDescriptor(
             name=self.name,

@@ -17,7 +17,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ._clock import Clock
-from ._parameters import Parameter
+from ._parameter_types import Parameter
 from ._time import ClockType
 
 if TYPE_CHECKING:
@@ -75,7 +75,7 @@ class TimeSource:
         self._own._set_ros_time_is_active(self.wanted)
         if self.wanted and self._clock_sub is None:
             from ._qos import QoSProfile
-            from .msgs.rosgraph_msgs import Clock as ClockMsg
+            from ..msgs.rosgraph_msgs import Clock as ClockMsg
 
             self._clock_sub = self.node.create_subscription(ClockMsg, "/clock", self._on_clock, QoSProfile(depth=1))
         return self._own

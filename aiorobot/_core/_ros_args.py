@@ -12,7 +12,7 @@ such sections); the rest are the program's own arguments. Understood:
 
 A ``node:`` prefix makes a rule apply only to the node of that name. ``-p`` values and
 ``--params-file`` sections apply in command-line order, as rcl reads them into one table
-(:func:`aiorobot._node_arguments.resolve_node_arguments`).
+(:func:`aiorobot._core._node_arguments.resolve_node_arguments`).
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ class RosArgs:
 
 def parse_ros_args(argv: Sequence[str]) -> RosArgs:
     """Split ``argv`` into ROS arguments (parsed) and the program's own (``unparsed``)."""
-    from .parameters._rcl_yaml import parse_yaml_value
+    from ..parameters._rcl_yaml import parse_yaml_value
 
     result = RosArgs()
     args = list(argv)

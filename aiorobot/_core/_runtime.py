@@ -66,7 +66,8 @@ class Runtime:
     Parameters
     ----------
     transport
-        ``"local"`` (one process) or a :class:`~aiorobot._transport.Transport`.
+        A registered transport name (``"local"``: one process; ``"zenoh"``) or a
+        :class:`~aiorobot._core._transport.Transport`.
     domain_id
         Separates graphs on a shared network (as ``ROS_DOMAIN_ID``).
     use_sim_time
@@ -221,7 +222,7 @@ class Runtime:
             self._waker = None
             raise
         if self.use_sim_time:
-            from .msgs.rosgraph_msgs import Clock as ClockMsg
+            from ..msgs.rosgraph_msgs import Clock as ClockMsg
 
             self._clock_tap = Tap(
                 ClockMsg,
@@ -236,7 +237,7 @@ class Runtime:
             self._bus.add_subscription(self._clock_tap)
         self._state = "running"
         if self._bus.debug_messages:
-            from .msgs._classgen import enable_assignment_checks
+            from ..msgs._classgen import enable_assignment_checks
 
             enable_assignment_checks()  # message field assignments are type and range checked
             self._assignment_checks = True
@@ -498,7 +499,7 @@ class Runtime:
             return
         self._state = "closing"
         if self._assignment_checks:
-            from .msgs._classgen import disable_assignment_checks
+            from ..msgs._classgen import disable_assignment_checks
 
             disable_assignment_checks()
             self._assignment_checks = False
