@@ -6,8 +6,8 @@ names, callback groups, parameter types, logging and the transport seam. Everyth
 private; the public names are re-exported once by ``aiorobot/__init__.py``.
 
 The core imports only itself, the standard library, ``aiorobot.msgs`` and
-``aiorobot.parameters`` (and, until the config file's loader leaves it, ``aiorobot._config``
-for ``Runtime(config=...)``); it finds transports by name in the registry of
+``aiorobot.parameters`` (``Runtime(config=...)`` reads a graph file through the loader that
+``aiorobot.launch`` installs); it finds transports by name in the registry of
 :mod:`aiorobot._core._transport` and never names an application or a transport
 implementation (docs/architecture.md; tests/test_layers.py keeps this true).
 """

@@ -56,7 +56,7 @@ def test_the_graph_file_is_an_aiorobot_run_config_naming_every_node() -> None:
 
 
 def test_the_example_and_the_demo_run_one_definition_of_the_dual_ekf() -> None:
-    from aiorobot._config import build_nodes
+    from aiorobot.launch import build_nodes
 
     shared = ("odom0", "odom0_config", "imu0", "imu0_config", "process_noise_covariance", "world_frame", "pose0",
               "pose0_config", "pose0_rejection_threshold")
