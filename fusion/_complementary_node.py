@@ -6,17 +6,11 @@ import math
 from typing import Any
 
 from aiorobot import Node
+from aiorobot.tf import quaternion_from_euler
 
 from ._complementary import ComplementaryEstimator
 
 __all__ = ["ComplementaryFilter"]
-
-
-def _quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
 
 
 class ComplementaryFilter(Node):
@@ -65,7 +59,7 @@ class ComplementaryFilter(Node):
         if self.estimator.rejected != before:
             self.get_logger().warning("/imu/data: skipped a sample with NaN or inf", throttle_duration_sec=5.0)
             return
-        q = _quaternion_from_rpy(roll, pitch, yaw)
+        q = quaternion_from_euler(roll, pitch, yaw)
         msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w = q
         self.fused_pub.publish(msg)
         if self._tf is not None:

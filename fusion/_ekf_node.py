@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from aiorobot import Node, compile_kernels
+from aiorobot.tf import quaternion_from_euler
 
 from ._ekf import STATE_SIZE, Ekf, check_covariance
 from ._inputs import (
@@ -26,18 +27,6 @@ from ._timeline import FilterTimeline, Measurement
 __all__ = ["EkfNode"]
 
 _NS = 1_000_000_000
-
-
-def _quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )
 
 
 class EkfNode(Node):
@@ -392,7 +381,7 @@ class EkfNode(Node):
 
         sec, nanosec = divmod((self._origin_ns or 0) + round(stamp_sec * _NS), _NS)
         stamp = TimeMsg(sec=int(sec), nanosec=int(nanosec))
-        q = _quaternion_from_rpy(x[3], x[4], x[5])
+        q = quaternion_from_euler(x[3], x[4], x[5])
         msg = self._odometry_type()
         msg.header.stamp = stamp
         msg.header.frame_id = self.world_frame
@@ -442,7 +431,7 @@ class EkfNode(Node):
 
             t.header.frame_id, t.child_frame_id = self.map_frame, self.odom_frame
             t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = (float(v) for v in map_odom[:3, 3])
-            qm = _quaternion_from_rpy(*rpy_from_rotation(map_odom[:3, :3]))
+            qm = quaternion_from_euler(*rpy_from_rotation(map_odom[:3, :3]))
             t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, t.transform.rotation.w = qm
         self._tf.send_transform(t)  # type: ignore[union-attr]
 
