@@ -17,6 +17,7 @@ from collections.abc import Callable, Coroutine
 from dataclasses import dataclass
 from typing import Any
 
+from ._handoff import call_on, wake
 from ._time import ClockType, Duration, Time
 
 __all__ = ["Clock", "ClockChange", "ClockJump", "JumpHandle", "JumpThreshold", "ROSClock", "TimeJump"]
@@ -109,14 +110,6 @@ class ClockJump(Exception):
     """Raised into a sim-time waiter when time jumps backwards (``/clock`` was reset)."""
 
 
-def _wake(fut: asyncio.Future[None], exc: BaseException | None) -> None:
-    if not fut.done():
-        if exc is None:
-            fut.set_result(None)
-        else:
-            fut.set_exception(exc)
-
-
 class Clock:
     """A clock as in rclpy: ``now()``, and for ROS time an optional sim-time override.
 
@@ -182,7 +175,7 @@ class Clock:
             self._change_waiters = []
         exc = ClockJump(f"ROS time {'activated' if enabled else 'deactivated'}")
         for loop, fut in due:
-            _call_on(loop, _wake, fut, exc)
+            call_on(loop, wake, fut, exc)
         _run_post(handles, TimeJump(change, Duration(nanoseconds=delta)))
 
     def set_ros_time_override(self, time_: Time) -> None:
@@ -259,7 +252,7 @@ class Clock:
             callbacks = list(self._jump_callbacks) if jumped_back else []
         exc = ClockJump(f"sim time jumped back from {previous} ns to {nanoseconds} ns") if jumped_back else None
         for loop, fut in due:
-            _call_on(loop, _wake, fut, exc)
+            call_on(loop, wake, fut, exc)
         for cb in callbacks:
             cb(previous, nanoseconds)
         _run_post(handles, TimeJump(ClockChange.ROS_TIME_NO_CHANGE, Duration(nanoseconds=nanoseconds - previous)))
@@ -381,15 +374,3 @@ def _run_post(handles: list[JumpHandle], jump: TimeJump) -> None:
 
 #: rclpy's name for the ROS-time clock; here every ROS_TIME ``Clock`` is one.
 ROSClock = Clock
-
-
-def _call_on(loop: asyncio.AbstractEventLoop, fn: Callable[..., object], *args: object) -> None:
-    """Run ``fn(*args)`` on ``loop``: now if we are on it, else through call_soon_threadsafe."""
-    try:
-        running = asyncio.get_running_loop()
-    except RuntimeError:
-        running = None
-    if running is loop:
-        fn(*args)
-    elif not loop.is_closed():
-        loop.call_soon_threadsafe(fn, *args)

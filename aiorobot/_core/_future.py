@@ -16,7 +16,7 @@ import threading
 from collections.abc import Callable, Coroutine, Generator
 from typing import Any, Generic, TypeVar
 
-from ._clock import _call_on
+from ._handoff import call_on, wake
 
 __all__ = ["Future", "future_of"]
 
@@ -132,7 +132,7 @@ class Future(Generic[T]):
             callbacks, self._callbacks = self._callbacks, []
             waiters, self._waiters = self._waiters, []
         for loop, waiter in waiters:
-            _call_on(loop, _wake, waiter)
+            call_on(loop, wake, waiter)
         for callback in callbacks:
             self._run_callback(callback)
         return True
@@ -157,11 +157,6 @@ class Future(Generic[T]):
                 _log.error("done callback %r of %r raised", callback, self, exc_info=True)
             return
         loop.call_soon(callback, self)
-
-
-def _wake(waiter: asyncio.Future[None]) -> None:
-    if not waiter.done():
-        waiter.set_result(None)
 
 
 def future_of(coro: Coroutine[Any, Any, T], loop: asyncio.AbstractEventLoop | None = None) -> Future[T]:

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from ._actions import DEFAULT_RESULT_TIMEOUT_SEC, ActionClient, ActionServer
 from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
+from ._handoff import post
 from ._logging import NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
 from ._node_graph import NodeGraphMixin
@@ -563,8 +564,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             fn(*args)
         elif threading.get_ident() == self._thread_id:
             fn(*args)
-        elif not loop.is_closed():
-            loop.call_soon_threadsafe(fn, *args)
+        else:
+            post(loop, fn, *args)
 
     def create_task(self, coro: Awaitable[Any], *, name: str | None = None) -> asyncio.Task[Any]:
         """Run ``coro`` as a task of this node, on its loop (call it from that loop).

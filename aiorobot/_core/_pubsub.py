@@ -32,6 +32,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
+from ._handoff import post
 from ._mutation import PublishGuard, digest
 from ..msgs._classgen import freezer
 from ._event_handler import Lease, PublisherEventCallbacks, SubscriptionEventCallbacks
@@ -244,12 +245,12 @@ class Publisher(Endpoint, Generic[M]):
             for sub in self._same_loop:
                 sub._enqueue(msg)
             for loop, subs in self._other_loops:
-                _call_threadsafe(loop, _enqueue_all, subs, msg)
+                post(loop, _enqueue_all, subs, msg)
         else:
             if self._same_loop and self._own_loop is not None:
-                _call_threadsafe(self._own_loop, _enqueue_all, self._same_loop, msg)
+                post(self._own_loop, _enqueue_all, self._same_loop, msg)
             for loop, subs in self._other_loops:
-                _call_threadsafe(loop, _enqueue_all, subs, msg)
+                post(loop, _enqueue_all, subs, msg)
         for tap in self._taps:
             tap._enqueue(msg)
 
@@ -291,9 +292,9 @@ class Publisher(Endpoint, Generic[M]):
         if threading.get_ident() == self._thread_id:
             deliver(self._same_loop, *args)
         elif self._same_loop and self._own_loop is not None:
-            _call_threadsafe(self._own_loop, deliver, self._same_loop, *args)
+            post(self._own_loop, deliver, self._same_loop, *args)
         for loop, subs in self._other_loops:
-            _call_threadsafe(loop, deliver, subs, *args)
+            post(loop, deliver, subs, *args)
         for tap in self._taps:
             tap._enqueue(msg)
 
@@ -352,13 +353,6 @@ def _deliver_all(subs: tuple[Subscription, ...], msg: Any, meta: Any) -> None:
 def _enqueue_all(subs: tuple[Subscription, ...], msg: Any) -> None:
     for sub in subs:
         sub._enqueue(msg)
-
-
-def _call_threadsafe(loop: asyncio.AbstractEventLoop, fn: Callable[..., Any], *args: Any) -> None:
-    try:
-        loop.call_soon_threadsafe(fn, *args)
-    except RuntimeError:  # the loop closed during shutdown: nobody is left to receive
-        pass
 
 
 class Tap(Endpoint):

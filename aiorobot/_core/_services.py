@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ._clock import _call_on
+from ._handoff import call_on, wake
 from ._errors import ServiceError
 from ._future import Future, future_of
 from ._service_introspection import ServiceIntrospection
@@ -276,7 +276,7 @@ def _reply(call: _Call, *, result: Any = None, exc: BaseException | None = None)
         for fn in call.after:  # queued behind the callbacks the result just scheduled
             call.loop.call_soon(fn)
 
-    _call_on(call.loop, deliver)
+    call_on(call.loop, deliver)
 
 
 class Client(_ServiceEndpoint):
@@ -426,7 +426,7 @@ class ServiceRegistry:
                 entry.clients.append(endpoint)
                 ready = []
         for fut in ready:
-            _call_on(fut.get_loop(), _resolve, fut)
+            call_on(fut.get_loop(), wake, fut)
         if self.listener is not None:
             self.listener.endpoint_added(endpoint)
 
@@ -473,8 +473,3 @@ class ServiceRegistry:
                 for name, e in sorted(self._entries.items())
                 if e.servers or e.clients
             ]
-
-
-def _resolve(fut: asyncio.Future[None]) -> None:
-    if not fut.done():
-        fut.set_result(None)

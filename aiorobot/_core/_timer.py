@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ._clock import ClockJump
+from ._handoff import post, wake
 from ._time import ClockType, Time
 
 if TYPE_CHECKING:
@@ -376,9 +377,7 @@ class Rate:
         self.destroyed = True
         sleepers, self._sleepers = self._sleepers, set()
         for fut in sleepers:
-            loop = fut.get_loop()
-            if not loop.is_closed():
-                loop.call_soon_threadsafe(_wake, fut)
+            post(fut.get_loop(), wake, fut)
 
     async def sleep(self) -> None:
         if self.destroyed:
@@ -403,15 +402,10 @@ class Rate:
                 waker.add(deadline, fut)
             self._sleepers.add(fut)
             if self.destroyed:  # destroy() ran in another thread before the add
-                _wake(fut)
+                wake(fut)
             try:
                 await fut
             finally:
                 self._sleepers.discard(fut)
         except ClockJump:
             self._next_ns = None
-
-
-def _wake(fut: asyncio.Future[None]) -> None:
-    if not fut.done():
-        fut.set_result(None)

@@ -24,6 +24,7 @@ import weakref
 from collections.abc import Callable, Coroutine, Iterator
 from typing import Any, TypeVar
 
+from .._core._handoff import post, wake
 from .._core._ros_args import RosArgs, parse_ros_args
 from .._core._runtime import Runtime
 from ..lowlevel import adopt_thread, stop_watching_stalls
@@ -215,7 +216,7 @@ class Context:
         waiters, self._finished_waiters = self._finished_waiters, []
         for waiter in waiters:
             if not waiter.done():
-                waiter.get_loop().call_soon_threadsafe(_resolve, waiter)
+                post(waiter.get_loop(), wake, waiter)
         self.wake()
 
     async def next_callback_finished(self) -> None:
@@ -232,10 +233,9 @@ class Context:
         if loop is None or waiter is None or loop.is_closed():
             return
         if threading.get_ident() == self._spin_thread:
-            if not waiter.done():
-                waiter.set_result(None)
+            wake(waiter)
         else:
-            loop.call_soon_threadsafe(_resolve, waiter)
+            post(loop, wake, waiter)
 
     def require_ok(self, what: str) -> None:
         if not self._ok or self.loop is None:
@@ -551,11 +551,6 @@ def _build_node(spec: str) -> Any:
         raise ValueError(f"--node: expected module:Class, found {spec!r}")
     factory = getattr(importlib.import_module(module_name), attr)
     return factory()
-
-
-def _resolve(waiter: asyncio.Future[None]) -> None:
-    if not waiter.done():
-        waiter.set_result(None)
 
 
 _default: Context | None = None

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._core._handoff import call_on, wake
 from ._buffer_core import DEFAULT_CACHE_TIME_SEC, BufferCore, check_frame_id_syntax
 from ._cache import display_time
 from ._conversions import check_supported
@@ -37,15 +38,6 @@ class _Waiter:
     future: asyncio.Future[None] | None = None
     event: threading.Event | None = field(default=None)
     failure: TransformException | None = None
-
-
-def _set_future(future: asyncio.Future[None], failure: TransformException | None) -> None:
-    if future.done():
-        return
-    if failure is None:
-        future.set_result(None)
-    else:
-        future.set_exception(failure)
 
 
 def _timeout_seconds(timeout: Any) -> float:
@@ -150,17 +142,7 @@ class Buffer(BufferCore):
             w.event.set()
             return
         assert w.loop is not None and w.future is not None
-        try:
-            current = asyncio.get_running_loop()
-        except RuntimeError:
-            current = None
-        if current is w.loop:
-            _set_future(w.future, w.failure)
-        else:
-            try:
-                w.loop.call_soon_threadsafe(_set_future, w.future, w.failure)
-            except RuntimeError:
-                pass  # the waiter's loop is closed: nobody is waiting any more
+        call_on(w.loop, wake, w.future, w.failure)  # a closed loop: nobody is waiting any more
 
     def _register(self, w: _Waiter) -> bool:
         """Add a waiter unless already satisfied; True when it must wait. Raises a final failure."""

@@ -33,6 +33,7 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from .._core._handoff import post
 from .._core._pubsub import Publisher, Subscription, Tap
 from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from .._core._services import Client, Service, _Call, _reply
@@ -615,12 +616,8 @@ class ZenohTransport(Transport):
             _log.warning(f"{text} ({self._drops[reason]} dropped so far for this reason)")
 
     def _to_loop(self, fn: Any, *args: Any) -> None:
-        loop = self._loop
-        if loop is not None and not loop.is_closed():
-            try:
-                loop.call_soon_threadsafe(fn, *args)
-            except RuntimeError:
-                pass
+        if self._loop is not None:
+            post(self._loop, fn, *args)
 
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)
