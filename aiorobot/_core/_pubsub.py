@@ -224,40 +224,35 @@ class Publisher(Endpoint, Generic[M]):
         rclpy difference: subscribers of one publish share one copy, whose arrays and
         sequences are read-only (docs/rclpy-differences.md).
         """
-        if not isinstance(msg, self.msg_type):
-            raise TypeError(
-                f"publisher on {self.topic_name} expects {self.type_name}, got {type(msg).__name__}: {msg!r}"
-            )
-        if self.destroyed:
-            raise RuntimeError(f"{self!r} was destroyed")
-        self.published += 1
-        if self._freeze is not None and (self._subs or self._history is not None):
-            msg = self._freeze(msg, self._frozen_classes)
-        if self._guard is not None and not self._guard.check(msg):
-            self.node.get_logger().error(
-                f"debug_messages: a message published on {self.topic_name} was changed after publish "
-                "(through an array it shares with subscribers); publish a new array each time",
-                throttle_duration_sec=1.0,
-            )
+        msg = self._accept(msg)
         if self._history is not None:
             self._history.append((msg, None))
-        if threading.get_ident() == self._thread_id:
-            for sub in self._same_loop:
-                sub._enqueue(msg)
-            for loop, subs in self._other_loops:
-                post(loop, _enqueue_all, subs, msg)
-        else:
-            if self._same_loop and self._own_loop is not None:
-                post(self._own_loop, _enqueue_all, self._same_loop, msg)
-            for loop, subs in self._other_loops:
-                post(loop, _enqueue_all, subs, msg)
-        for tap in self._taps:
-            tap._enqueue(msg)
+        self._fan_out(_enqueue_all, msg)
 
     def _publish_watched(self, msg: M) -> None:
         """:meth:`publish` for a publisher with a finite deadline, lease or lifespan, or with a
         subscriber that takes MessageInfo: restarts its leases, and hands subscribers the
         message's source time, sequence number and expiry with it."""
+        msg = self._accept(msg)
+        if self._deadline is not None:
+            self._deadline.touch()
+        if self._liveliness is not None:
+            self._assert_alive()
+        if not self._info:
+            if self._history is not None:
+                self._history.append((msg, None))
+            self._fan_out(_enqueue_all, msg)
+            return
+        lifespan = self._lifespan_ns
+        expiry = self.node._clock.now_ns() + lifespan if lifespan is not None else None
+        meta = (time.time_ns(), self.published, expiry)
+        if self._history is not None:
+            self._history.append((msg, meta))
+        self._fan_out(_deliver_all, msg, meta)
+
+    def _accept(self, msg: M) -> M:
+        """The checks and the copy every publish makes: the type, a destroyed publisher, the
+        count, the copy subscribers share, the ``debug_messages`` guard."""
         if not isinstance(msg, self.msg_type):
             raise TypeError(
                 f"publisher on {self.topic_name} expects {self.type_name}, got {type(msg).__name__}: {msg!r}"
@@ -265,15 +260,6 @@ class Publisher(Endpoint, Generic[M]):
         if self.destroyed:
             raise RuntimeError(f"{self!r} was destroyed")
         self.published += 1
-        if self._deadline is not None:
-            self._deadline.touch()
-        if self._liveliness is not None:
-            self._assert_alive()
-        meta = None
-        if self._info:
-            lifespan = self._lifespan_ns
-            expiry = self.node._clock.now_ns() + lifespan if lifespan is not None else None
-            meta = (time.time_ns(), self.published, expiry)
         if self._freeze is not None and (self._subs or self._history is not None):
             msg = self._freeze(msg, self._frozen_classes)
         if self._guard is not None and not self._guard.check(msg):
@@ -282,19 +268,17 @@ class Publisher(Endpoint, Generic[M]):
                 "(through an array it shares with subscribers); publish a new array each time",
                 throttle_duration_sec=1.0,
             )
-        if self._history is not None:
-            self._history.append((msg, meta))
-        if meta is None:
-            deliver: Callable[..., None] = _enqueue_all
-            args: tuple[Any, ...] = (msg,)
-        else:
-            deliver, args = _deliver_all, (msg, meta)
+        return msg
+
+    def _fan_out(self, deliver: Callable[..., None], msg: Any, *meta: Any) -> None:
+        """Run ``deliver(subscriptions, msg, *meta)`` on each matched loop: inline for this loop's
+        subscriptions when called on its thread, posted otherwise; taps take ``msg`` inline."""
         if threading.get_ident() == self._thread_id:
-            deliver(self._same_loop, *args)
+            deliver(self._same_loop, msg, *meta)
         elif self._same_loop and self._own_loop is not None:
-            post(self._own_loop, deliver, self._same_loop, *args)
+            post(self._own_loop, deliver, self._same_loop, msg, *meta)
         for loop, subs in self._other_loops:
-            post(loop, deliver, subs, *args)
+            post(loop, deliver, subs, msg, *meta)
         for tap in self._taps:
             tap._enqueue(msg)
 
