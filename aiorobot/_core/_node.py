@@ -177,6 +177,22 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
     # -- entities ---------------------------------------------------------------------
 
+    def _register(self, entity: Any, entities: list[Any]) -> None:
+        """Keep ``entity`` in ``entities`` and, once the node is in a runtime, put it on the bus
+        (:meth:`Runtime._bus_add`) and start it if the node has started; an entity the bus refuses
+        is not kept."""
+        entities.append(entity)
+        if self._runtime is None:
+            return
+        try:
+            self._runtime._bus_add(entity)
+        except BaseException:
+            entities.remove(entity)
+            raise
+        start = getattr(entity, "_start", None)
+        if self._started and start is not None:
+            self._call_soon(start)
+
     def create_publisher(
         self,
         msg_type: type[M],
@@ -193,15 +209,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             self, msg_type, self.resolve_topic_name(topic), to_qos_profile(qos),
             event_callbacks=event_callbacks, callback_group=callback_group or self._default_group,
         )
-        self._publishers.append(pub)
-        if self._runtime is not None:
-            try:
-                self._runtime._bus.add_publisher(pub)
-            except BaseException:
-                self._publishers.remove(pub)
-                raise
-            if self._started:
-                self._call_soon(pub._start)
+        self._register(pub, self._publishers)
         return pub
 
     def create_subscription(
@@ -247,15 +255,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             event_callbacks=event_callbacks,
             raw=raw,
         )
-        self._subscriptions.append(sub)
-        if self._runtime is not None:
-            try:
-                self._runtime._bus.add_subscription(sub)
-            except BaseException:
-                self._subscriptions.remove(sub)
-                raise
-            if self._started:
-                self._call_soon(sub._start)
+        self._register(sub, self._subscriptions)
         return sub
 
     def create_timer(
@@ -297,7 +297,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             self._publishers.remove(pub)
             pub.destroyed = True
             if self._runtime is not None:
-                self._runtime._bus.remove(pub)
+                self._runtime._bus_remove(pub)
             self._call_soon(pub._stop)
             return True
         return False
@@ -307,7 +307,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         if sub in self._subscriptions:
             self._subscriptions.remove(sub)
             if self._runtime is not None:
-                self._runtime._bus.remove(sub)
+                self._runtime._bus_remove(sub)
             self._call_soon(self._close_subscription, sub)
             return True
         return False
@@ -356,11 +356,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         service = Service(
             self, srv_type, self.resolve_topic_name(srv_name, kind="service"), callback, callback_group or self._default_group
         )
-        self._services.append(service)
-        if self._runtime is not None:
-            self._runtime._bus.services.add(service)
-            if self._started:
-                self._call_soon(service._start)
+        self._register(service, self._services)
         return service
 
     def create_client(
@@ -375,9 +371,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         client = Client(
             self, srv_type, self.resolve_topic_name(srv_name, kind="service"), callback_group or self._default_group
         )
-        self._clients.append(client)
-        if self._runtime is not None:
-            self._runtime._bus.services.add(client)
+        self._register(client, self._clients)
         return client
 
     def create_action_server(
@@ -421,7 +415,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         if service in self._services:
             self._services.remove(service)
             if self._runtime is not None:
-                self._runtime._bus.services.remove(service)
+                self._runtime._bus_remove(service)
             self._call_soon(service._close)
             return True
         return False
@@ -432,7 +426,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             self._clients.remove(client)
             client.destroyed = True
             if self._runtime is not None:
-                self._runtime._bus.services.remove(client)
+                self._runtime._bus_remove(client)
             return True
         return False
 

@@ -19,7 +19,7 @@ from ._clock import Clock
 from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._node import Node
 from ._priority import PriorityLoop
-from ._pubsub import Tap
+from ._pubsub import Publisher, Subscription, Tap
 from ._qos import QoSProfile, ReliabilityPolicy
 from ._time import ClockType, Time
 from ._transport import MAX_DOMAIN_ID, Transport, make_transport
@@ -287,22 +287,15 @@ class Runtime:
         self.transport.node_added(node)
         try:
             node.on_added()
-            for pub in node._publishers:
-                self._bus.add_publisher(pub)
-                added.append(pub)
-            for sub in node._subscriptions:
-                self._bus.add_subscription(sub)
-                added.append(sub)
+            for entity in (*node._publishers, *node._subscriptions, *node._services, *node._clients):
+                self._bus_add(entity)
+                added.append(entity)
         except BaseException:
-            for endpoint in added:
-                self._bus.remove(endpoint)
+            for entity in added:
+                self._bus_remove(entity)
             self.transport.node_removed(node)
             node._unbind()
             raise
-        for service in node._services:
-            self._bus.services.add(service)
-        for client in node._clients:
-            self._bus.services.add(client)
         self._nodes.append(node)
         node._call_soon(node._start)
         return node
@@ -316,6 +309,23 @@ class Runtime:
         pubs = [p for n in nodes for p in n._publishers]
         subs = [s for n in nodes for s in n._subscriptions]
         return [self._bus.incompatibility(p, s, reason) for p, s, reason in self._bus.preview(pubs, subs)]
+
+    def _bus_add(self, entity: Any) -> None:
+        """Put a node's publisher, subscription, service or client on the bus (matched with its
+        peers, announced through the transport)."""
+        if isinstance(entity, Publisher):
+            self._bus.add_publisher(entity)
+        elif isinstance(entity, Subscription):
+            self._bus.add_subscription(entity)
+        else:
+            self._bus.services.add(entity)
+
+    def _bus_remove(self, entity: Any) -> None:
+        """Take what :meth:`_bus_add` put on the bus off it again."""
+        if isinstance(entity, (Publisher, Subscription)):
+            self._bus.remove(entity)
+        else:
+            self._bus.services.remove(entity)
 
     def add_nodes(self, nodes: list[tuple[Node, str]]) -> None:
         """Add several ``(node, executor)`` pairs; under ``strict_qos`` all or none."""
@@ -331,15 +341,11 @@ class Runtime:
         if node not in self._nodes:
             raise ValueError(f"{node!r} is not in this runtime")
         self._nodes.remove(node)
-        self._detach(node)
+        self._detach_node(node)
 
-    def _detach(self, node: Node) -> None:
-        for endpoint in [*node._publishers, *node._subscriptions]:
-            self._bus.remove(endpoint)
-        for service in node._services:
-            self._bus.services.remove(service)
-        for client in node._clients:
-            self._bus.services.remove(client)
+    def _detach_node(self, node: Node) -> None:
+        for entity in (*node._publishers, *node._subscriptions, *node._services, *node._clients):
+            self._bus_remove(entity)
         self.transport.node_removed(node)
         loop = node._loop
         if loop is not None and not loop.is_closed():
@@ -528,7 +534,7 @@ class Runtime:
         # 3. Stop every node.
         for node in nodes:
             self._nodes.remove(node)
-            self._detach(node)
+            self._detach_node(node)
         if self._stopping:
             stopping = [f if isinstance(f, asyncio.Future) else asyncio.wrap_future(f) for f in self._stopping]
             _, late_stops = await asyncio.wait(stopping, timeout=max(remaining(), 0.05))
