@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ._parser import positive_seconds
+from ._parser import positive_seconds, transport_name
 
 __all__ = ["add_arguments", "main"]
 
@@ -79,7 +79,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _transport_args(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--transport", default="zenoh", choices=("zenoh", "local"),
+    parser.add_argument("--transport", default="zenoh", type=transport_name, metavar="NAME",
                         help="how to reach the graph (default zenoh; 'local' is an empty graph in this process)")
     parser.add_argument("--domain-id", type=int, default=None, metavar="N", help="ROS domain id (default: $ROS_DOMAIN_ID or 0)")
 

@@ -8,6 +8,7 @@ import re
 import sys
 from collections.abc import Sequence
 from typing import Any
+from ._parser import transport_name
 
 __all__ = ["add_arguments", "main", "run_script"]
 
@@ -17,7 +18,7 @@ _ENTRY_POINT = re.compile(r"[A-Za-z_][\w.]*:[A-Za-z_][\w.]*")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--transport", choices=("local", "zenoh"), default="local",
+        "--transport", type=transport_name, metavar="NAME", default="local",
         help="local: the program's nodes talk in-process (default); zenoh: with other processes "
         "(ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE apply, as in rmw_zenoh)",
     )

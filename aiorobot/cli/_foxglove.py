@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._parser import positive_seconds
+from ._parser import positive_seconds, transport_name
 
 __all__ = ["add_arguments", "main"]
 
@@ -29,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
     parser.add_argument("--max-large-hz", type=float, default=10.0, metavar="HZ", help="rate limit per image/cloud topic (default 10)")
     parser.add_argument("--duration", type=positive_seconds, metavar="S", help="stop after S seconds (default: until Ctrl-C)")
-    parser.add_argument("--transport", default="zenoh", choices=("zenoh", "local"), help="how to reach the graph (default zenoh)")
+    parser.add_argument("--transport", default="zenoh", type=transport_name, metavar="NAME", help="how to reach the graph (default zenoh)")
     parser.add_argument("--domain-id", type=int, default=None, metavar="N", help="ROS domain id (default: $ROS_DOMAIN_ID or 0)")
 
 

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._parser import positive_seconds
+from ._parser import positive_seconds, transport_name
 
 __all__ = ["add_arguments", "main"]
 
@@ -18,7 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     save.add_argument("file", type=Path, metavar="FILE", help="output path without extension (FILE.yaml, FILE.pgm)")
     save.add_argument("-t", "--topic", default="/map", help="map topic (default /map)")
     save.add_argument("--timeout", type=positive_seconds, default=10.0, metavar="S", help="give up after S seconds (default 10)")
-    save.add_argument("--transport", default="zenoh", choices=("zenoh", "local"), help="how to reach the graph (default zenoh)")
+    save.add_argument("--transport", default="zenoh", type=transport_name, metavar="NAME", help="how to reach the graph (default zenoh)")
 
 
 def main(args: argparse.Namespace) -> int:

@@ -7,7 +7,7 @@ import math
 import re
 from typing import NoReturn
 
-__all__ = ["ArgumentParser", "accept_negative_number_lists", "positive_seconds"]
+__all__ = ["ArgumentParser", "accept_negative_number_lists", "positive_seconds", "transport_name"]
 
 _NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 #: what argparse's own test for a negative number (``-1``, ``-.5``) misses: lists such as ``-0.55,-0.55``
@@ -43,3 +43,14 @@ def positive_seconds(text: str) -> float:
     if not math.isfinite(value) or value <= 0.0:
         raise argparse.ArgumentTypeError(f"expected a positive number of seconds, found {text!r}")
     return value
+
+
+def transport_name(text: str) -> str:
+    """argparse ``type=`` for ``--transport``: a name in the transport registry (``local``, ``zenoh``
+    and whatever an installed package registered), asked when the option is used, not listed here."""
+    from .._core._transport import transport_names
+
+    names = transport_names()
+    if text not in names:
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(names)}, found {text!r}")
+    return text

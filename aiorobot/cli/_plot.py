@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ._parser import positive_seconds
+from ._parser import positive_seconds, transport_name
 
 __all__ = ["add_arguments", "field_value", "main", "split_series"]
 
@@ -68,7 +68,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--bag", type=Path, metavar="DIR", help="read from this bag instead of the live graph")
     parser.add_argument("--duration", type=positive_seconds, default=10.0, metavar="S", help="live: record S seconds first (default 10)")
     parser.add_argument("-o", "--output", type=Path, default=Path("plot.png"), metavar="FILE.png", help="image to write (default plot.png)")
-    parser.add_argument("--transport", default="zenoh", choices=("zenoh", "local"), help="live: how to reach the graph (default zenoh)")
+    parser.add_argument("--transport", default="zenoh", type=transport_name, metavar="NAME", help="live: how to reach the graph (default zenoh)")
 
 
 def main(args: argparse.Namespace) -> int:

@@ -103,3 +103,34 @@ def test_registering_a_taken_name_or_a_bad_one_says_so(registry) -> None:
         register_transport("tcp/1", RecordingTransport)
     with pytest.raises(TypeError, match=r"^transport 'x': expected a factory"):
         register_transport("x", "aiorobot.transport:ZenohTransport")  # type: ignore[arg-type]
+
+
+def test_config_files_and_the_cli_accept_the_registrys_names_not_a_list_of_their_own(registry, tmp_path) -> None:
+    from aiorobot.cli._exec import add_arguments
+    from aiorobot.cli._parser import ArgumentParser
+    from aiorobot.launch import load_config
+
+    config = tmp_path / "graph.toml"
+    config.write_text('[runtime]\ntransport = "recording"\n\n[[nodes]]\nuse = "aiorobot.examples:Talker"\n')
+    from aiorobot._core._errors import ConfigError
+
+    with pytest.raises(ConfigError, match=r'runtime\.transport: expected "local" or "zenoh", found "recording"'):
+        load_config(config)
+    parser = ArgumentParser(prog="aiorobot exec")
+    add_arguments(parser)
+    with pytest.raises(SystemExit):
+        parser.parse_args(["--transport", "recording", "prog.py"])
+
+    register_transport("recording", RecordingTransport)
+    assert load_config(config).runtime.transport == "recording"
+    assert parser.parse_args(["--transport", "recording", "prog.py"]).transport == "recording"
+
+
+def test_an_unknown_transport_on_the_command_line_is_one_line_naming_the_choices() -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "aiorobot.cli", "exec", "--transport", "udp", "prog.py"],
+        capture_output=True, text=True, timeout=60,
+    )
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert "--transport: expected one of" in result.stderr and "zenoh" in result.stderr and "'udp'" in result.stderr
