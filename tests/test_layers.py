@@ -11,9 +11,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 #: rooms the core may import besides itself
-CORE_MAY_IMPORT = {"msgs", "parameters"}
-#: ... and, until the config file's loader leaves the core (issue #28 item 2), the config model
-CORE_MAY_IMPORT_FOR_NOW: set[str] = set()
+CORE_MAY_IMPORT = {"msgs"}
 #: what the issue names: the core imports none of these, ever
 CORE_MUST_NOT_IMPORT = {"bag", "foxglove", "sim", "nav", "demo", "cli", "bench", "testing", "compat", "launch", "transport"}
 #: production modules that still import the test kit (issue #28: being changed; remove each once it no longer does)
@@ -45,8 +43,8 @@ def test_the_core_imports_no_application_extension_or_transport(layers) -> None:
     targets = _core_targets(layers)
     forbidden = {room: where for room, where in targets.items() if room in CORE_MUST_NOT_IMPORT}
     assert not forbidden, f"the core must not import these layers: {forbidden}"
-    others = {room: where for room, where in targets.items() if room not in CORE_MAY_IMPORT | CORE_MAY_IMPORT_FOR_NOW}
-    assert not others, f"the core imports only msgs and parameters (docs/architecture.md); found {others}"
+    others = {room: where for room, where in targets.items() if room not in CORE_MAY_IMPORT}
+    assert not others, f"the core imports only msgs (docs/architecture.md); found {others}"
     assert "msgs" in targets  # the collector does see the core's imports
 
 
@@ -81,3 +79,10 @@ def test_the_architecture_page_shows_the_current_imports(layers) -> None:
     generated = layers.render()
     assert generated in text, "docs/architecture.md is out of date: run python tools/layers.py --write"
     assert "## Where extensions plug in" in text and "(docs/architecture.md)" in (ROOT / "README.md").read_text()
+
+
+def test_no_import_runs_up_the_layers_or_closes_a_circle(layers) -> None:
+    found = layers.summary()
+    upward = [f"{a} -> {b} ({stmts[0].path}:{stmts[0].line})" for a, b, stmts in found["upward"]]
+    assert not upward, f"imports that run up docs/architecture.md's layers: {upward}"
+    assert not found["back"], f"import circles between rooms: {sorted(found['back'])}"

@@ -38,8 +38,10 @@ BEGIN, END = "<!-- layers:begin (tools/layers.py --write) -->", "<!-- layers:end
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("messages", ("msgs",)),
     ("core", ("_core", "parameters", "lowlevel")),  # lowlevel: the public seam over the core (#28 item 4)
-    ("libraries", ("transport", "tf", "lifecycle", "message_filters", "launch", "_config", "_config_build")),
+    ("libraries", ("transport", "tf", "lifecycle", "message_filters")),
     ("domains", ("perception", "control", "fusion", "bag", "foxglove", "nav", "sim")),
+    # launch composes a graph from a config file: any domain's nodes, the recorder, the bridge
+    ("composition", ("launch", "_config", "_config_build")),
     ("applications", ("demo", "bench", "cli", "compat", "examples", "testing")),
 )
 

@@ -25,7 +25,7 @@ from ._logging import NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
 from ._node_graph import NodeGraphMixin
 from ._node_parameters import NodeParametersMixin
-from ..parameters._store import ParameterStore
+from ._parameter_store import ParameterStore
 from ._event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile

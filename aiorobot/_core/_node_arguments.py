@@ -67,7 +67,7 @@ def _cli_overrides(args: Any, fqn: str) -> tuple[dict[str, Any], dict[str, str]]
     order each first appeared. So ``-p x:=1 --params-file f.yaml`` gives the file's ``x``
     (rclpy test_node.py::TestNode::test_declare_parameter).
     """
-    from ..parameters._files import _node_regex, load_parameter_file
+    from ._parameter_files import _node_regex, load_parameter_file
 
     sections: dict[str, tuple[Any, dict[str, tuple[Any, str]]]] = {}
     for item in args.overrides_in_order:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
-from ..parameters._store import OnSetCallback, ParameterStore, PostSetCallback, PreSetCallback
+from ._parameter_store import OnSetCallback, ParameterStore, PostSetCallback, PreSetCallback
 from ._parameter_types import Parameter, ParameterDescriptor, ParameterType, SetParametersResult
 
 __all__ = ["NodeParametersMixin"]
@@ -18,7 +18,7 @@ class NodeParametersMixin:
 
     def _setup_parameters(self, auto_declare: bool, start_services: bool) -> None:
         """``/parameter_events``, the node's ``use_sim_time`` and, unless told not to, its parameter services."""
-        from ..parameters._services import ParameterEventPublisher, create_parameter_services
+        from ._parameter_services import ParameterEventPublisher, create_parameter_services
         from ._time_source import TimeSource
 
         self._parameters.event_hook = ParameterEventPublisher(self)  # type: ignore[arg-type]

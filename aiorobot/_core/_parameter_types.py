@@ -2,7 +2,7 @@
 conversions to and from ``rcl_interfaces`` messages.
 
 The node-side rules (declaration, overrides, callbacks, events) live in
-:mod:`aiorobot.parameters._store`.
+:mod:`aiorobot._core._parameter_store`.
 """
 
 from __future__ import annotations

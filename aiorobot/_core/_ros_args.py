@@ -79,7 +79,7 @@ class RosArgs:
 
 def parse_ros_args(argv: Sequence[str]) -> RosArgs:
     """Split ``argv`` into ROS arguments (parsed) and the program's own (``unparsed``)."""
-    from ..parameters._rcl_yaml import parse_yaml_value
+    from ._rcl_yaml import parse_yaml_value
 
     result = RosArgs()
     args = list(argv)

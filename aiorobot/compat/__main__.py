@@ -2,6 +2,6 @@
 
 import sys
 
-from ..cli._exec import run_script
+from ._run import run_script
 
 sys.exit(run_script(sys.argv[1:], prog="python -m aiorobot.compat"))

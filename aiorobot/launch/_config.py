@@ -475,7 +475,7 @@ def _parse_node(checker: _Checker, index: int, table: Any) -> NodeConfig:
 
 def _parameters_file(checker: _Checker, table: Mapping[str, Any], key: str) -> str | None:
     """``parameters_file = "params.yaml"`` (relative to the config file): exists and parses."""
-    from ..parameters._files import ParameterFileError, load_parameter_file
+    from .._core._parameter_files import ParameterFileError, load_parameter_file
 
     if "parameters_file" not in table:
         return None

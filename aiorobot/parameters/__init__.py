@@ -8,8 +8,8 @@ from ``aiorobot``; a node's parameter methods are rclpy's (see :class:`aiorobot.
 from __future__ import annotations
 
 from .._core._parameter_types import get_parameter_value, parameter_value_to_python
-from ._files import ParameterFile, ParameterFileError, load_parameter_file, parameter_dict_from_yaml_file
-from ._services import qos_profile_parameter_events
+from .._core._parameter_files import ParameterFile, ParameterFileError, load_parameter_file, parameter_dict_from_yaml_file
+from .._core._parameter_services import qos_profile_parameter_events
 
 __all__ = [
     "ParameterFile",

@@ -15,7 +15,7 @@ import pytest
 from aiorobot import InvalidParameterTypeError, Node, Parameter
 from aiorobot._core._ros_args import RosArgsError, parse_ros_args
 from aiorobot.parameters import ParameterFileError, load_parameter_file
-from aiorobot.parameters._rcl_yaml import rcl_scalar
+from aiorobot._core._rcl_yaml import rcl_scalar
 
 DUAL = """\
 ekf_filter_node_odom:

@@ -1,7 +1,7 @@
 """``rclpy.parameter``: ``Parameter``, its type, and rclpy's conversion helpers."""
 
 from ..._core._parameter_types import Parameter, ParameterType, get_parameter_value, parameter_value_to_python
-from ...parameters._files import parameter_dict_from_yaml_file
+from ..._core._parameter_files import parameter_dict_from_yaml_file
 
 __all__ = [
     "Parameter", "ParameterType", "get_parameter_value", "parameter_dict_from_yaml_file",

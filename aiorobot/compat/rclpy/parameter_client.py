@@ -14,7 +14,7 @@ from typing import Any
 
 from ...msgs import rcl_interfaces as _ri
 from ..._core._parameter_types import Parameter
-from ...parameters._files import parameter_dict_from_yaml_file
+from ..._core._parameter_files import parameter_dict_from_yaml_file
 from .qos import qos_profile_parameter_events, qos_profile_services_default
 
 __all__ = ["AsyncParameterClient"]

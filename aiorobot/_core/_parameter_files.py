@@ -92,7 +92,7 @@ class ParameterFile:
 
 def load_parameter_file(path: str | Path) -> ParameterFile:
     """Read a ROS 2 parameter file with rcl's scalar types (``1e-9`` is a double; see
-    :mod:`aiorobot.parameters._rcl_yaml`); ``FileNotFoundError`` when missing, ``ParameterFileError``
+    :mod:`aiorobot._core._rcl_yaml`); ``FileNotFoundError`` when missing, ``ParameterFileError``
     when malformed.
 
     rclpy difference: a list mixing integers and doubles is a double array (rcl refuses it).
@@ -180,7 +180,7 @@ def parameter_dict_from_yaml_file(
     Loads every node's section when ``target_nodes`` is empty (``/**`` only with
     ``use_wildcard``); ``RuntimeError`` when a target node is not in the file.
     """
-    from .._core._parameter_types import Parameter
+    from ._parameter_types import Parameter
 
     loaded = load_parameter_file(parameter_file)
     patterns = [s.pattern for s in loaded.sections]

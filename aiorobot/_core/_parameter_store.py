@@ -16,7 +16,7 @@ import inspect
 from collections.abc import Awaitable, Callable, Generator, Iterable, Mapping, Sequence
 from typing import Any
 
-from .._core._errors import (
+from ._errors import (
     InvalidParameterTypeError,
     InvalidParameterValueError,
     ParameterAlreadyDeclaredError,
@@ -24,7 +24,7 @@ from .._core._errors import (
     ParameterNotDeclaredError,
     ParameterUninitializedError,
 )
-from .._core._parameter_types import (
+from ._parameter_types import (
     SEPARATOR,
     FloatingPointRange,
     IntegerRange,

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from .._core._errors import ParameterNotDeclaredError, ParameterUninitializedError
-from .._core._parameter_types import Parameter, SetParametersResult
-from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from ._errors import ParameterNotDeclaredError, ParameterUninitializedError
+from ._parameter_types import Parameter, SetParametersResult
+from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 if TYPE_CHECKING:
-    from .._core._node import Node
+    from ._node import Node
 
 __all__ = ["SERVICE_NAMES", "ParameterEventPublisher", "create_parameter_services", "qos_profile_parameter_events"]
 
