@@ -171,7 +171,7 @@ async def _serve(
 
     group = ProcessGroup(config, process, supervisor=supervisor, supervise=supervise, status_period_sec=status_period_sec)
     try:
-        status = await _serve_process(config, nodes, duration_sec, status_period_sec, keep_going, group)
+        status = await _serve_process(config, nodes, duration_sec, status_period_sec, keep_going, group, process)
     finally:
         await group.stop()
     return group.outcome(status)
@@ -184,14 +184,17 @@ async def _serve_process(
     status_period_sec: float,
     keep_going: bool,
     group: Any,
+    process: str,
 ) -> int:
     from aiorobot import Runtime
-    from aiorobot.launch import ConfigError, runtime_options
+    from aiorobot.launch import ConfigError, node_configs, runtime_options
     from aiorobot.lowlevel import set_on_failure
     from ._status import StatusDisplay
 
-    for (node, _), node_config in zip(nodes, config.nodes):
-        set_on_failure(node, "continue" if keep_going and node_config.on_failure == "stop" else node_config.on_failure)
+    tables = node_configs(config, nodes, process)
+    for (node, _), node_config in zip(nodes, tables):
+        policy = node_config.on_failure if node_config is not None else "stop"  # the recorder, the bridge
+        set_on_failure(node, "continue" if keep_going and policy == "stop" else policy)
     runtime_config = config.runtime
     from aiorobot._core._transport import make_transport
 
@@ -206,9 +209,10 @@ async def _serve_process(
             for problem in rt.check_qos([node for node, _ in nodes]):
                 owners = {problem.publisher_node, problem.subscription_node}
                 index = max(i for i, (n, _) in enumerate(nodes) if n.get_fully_qualified_name() in owners)
+                table = tables[index]
                 raise ConfigError(
                     config.path,
-                    config.nodes[index].key,
+                    table.key if table is not None else "record" if index == 0 else "foxglove",
                     f"runtime.strict_qos is set and {problem}",
                 )
         rt.add_nodes(nodes)

@@ -12,7 +12,7 @@ behind ``Runtime(config=...)`` (``aiorobot.Runtime`` imports it for that).
 from __future__ import annotations
 
 from .._core._runtime import install_config_loader
-from ._build import build_nodes
+from ._build import build_nodes, node_configs
 from ._config import (
     MAIN_PROCESS,
     ConfigError,
@@ -38,6 +38,7 @@ __all__ = [
     "RuntimeConfig",
     "build_nodes",
     "load_config",
+    "node_configs",
     "open_runtime",
     "parse_config",
     "runtime_options",

@@ -22,7 +22,7 @@ from .._core._errors import InvalidParameterValueError
 if TYPE_CHECKING:
     from aiorobot import Node
 
-__all__ = ["build_nodes", "import_node_class"]
+__all__ = ["build_nodes", "import_node_class", "node_configs"]
 
 
 def build_nodes(config: GraphConfig, process: str = MAIN_PROCESS) -> list[tuple[Node, str]]:
@@ -75,6 +75,20 @@ def build_nodes(config: GraphConfig, process: str = MAIN_PROCESS) -> list[tuple[
         fox = config.foxglove
         built.append((FoxgloveBridge(host=fox.host, port=fox.port, max_large_hz=fox.max_large_hz), "main"))
     return built
+
+
+def node_configs(config: GraphConfig, nodes: list[tuple[Node, str]], process: str = MAIN_PROCESS) -> list[NodeConfig | None]:
+    """The ``[[nodes]]`` table each of ``build_nodes(config, process)``'s nodes came from, in the
+    same order; None for the ``[record]`` recorder and the Foxglove bridge, which no table names."""
+    tables = iter([n for n in config.nodes if n.process == process])
+    main = process == MAIN_PROCESS
+    out: list[NodeConfig | None] = []
+    for index, (node, _) in enumerate(nodes):
+        extra = (config.record is not None and main and index == 0) or (
+            config.foxglove is not None and main and index == len(nodes) - 1
+        )
+        out.append(None if extra else next(tables))
+    return out
 
 
 def _recorder(config: GraphConfig) -> Node:

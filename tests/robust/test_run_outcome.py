@@ -163,3 +163,44 @@ def test_square_cmd_vel_example_prints_its_pattern_when_run():
     assert result.returncode == 0, result.stderr
     assert "linear.x=+0.30" in result.stdout
     assert "aiorobot run examples/mecanum_serial.toml" in result.stdout
+
+
+def test_on_failure_stays_with_its_own_node_when_a_recorder_runs_first(tmp_path):
+    """[record] puts the recorder before the file's nodes: each node still gets its own table's
+    on_failure (it went to the node one place later, so "continue" here stopped the run)."""
+    (tmp_path / "faulty.py").write_text(NODES)
+    (tmp_path / "g.toml").write_text(
+        '[record]\npath = "run"\n\n'
+        '[[nodes]]\nuse = "faulty:Faulty"\nname = "ok"\nparameters = { fail = "nothing" }\n\n'
+        '[[nodes]]\nuse = "faulty:Faulty"\nname = "flaky"\non_failure = "continue"\n'
+        'parameters = { fail = "on_start" }\n'
+    )
+    result = subprocess.run(
+        [AIOROBOT, "run", "g.toml", "--duration", "1"], cwd=tmp_path, capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 1, result.stderr
+    assert "/flaky: failed to start (on_start raised)" in result.stderr
+    assert "stopping the run" not in result.stderr
+    assert "tick 20" in result.stdout  # the run went on for its duration
+
+
+def test_node_configs_pairs_each_built_node_with_its_table(tmp_path):
+    from aiorobot.launch import build_nodes, load_config, node_configs
+
+    (tmp_path / "faulty.py").write_text(NODES)
+    (tmp_path / "g.toml").write_text(
+        '[runtime]\nfoxglove = { port = 0 }\n\n[record]\npath = "run"\n\n'
+        '[[nodes]]\nuse = "faulty:Faulty"\nname = "a"\n\n'
+        '[[nodes]]\nuse = "faulty:Faulty"\nname = "b"\nprocess = "worker"\n\n'
+        '[[nodes]]\nuse = "faulty:Faulty"\nname = "c"\n\n'
+        '[processes.worker]\n'
+    )
+    config = load_config(tmp_path / "g.toml")
+    try:
+        main = build_nodes(config)
+        worker = build_nodes(config, "worker")
+    finally:
+        sys.path.remove(str(tmp_path)) if str(tmp_path) in sys.path else None
+    assert [t.name if t else None for t in node_configs(config, main)] == [None, "a", "c", None]
+    assert [n.get_name() for n, _ in main][1:3] == ["a", "c"]
+    assert [t.name for t in node_configs(config, worker, "worker")] == ["b"]
