@@ -227,7 +227,7 @@ class Publisher(Endpoint, Generic[M]):
         msg = self._accept(msg)
         if self._history is not None:
             self._history.append((msg, None))
-        self._fan_out(_enqueue_all, msg)
+        self._fan_out(msg)
 
     def _publish_watched(self, msg: M) -> None:
         """:meth:`publish` for a publisher with a finite deadline, lease or lifespan, or with a
@@ -241,14 +241,14 @@ class Publisher(Endpoint, Generic[M]):
         if not self._info:
             if self._history is not None:
                 self._history.append((msg, None))
-            self._fan_out(_enqueue_all, msg)
+            self._fan_out(msg)
             return
         lifespan = self._lifespan_ns
         expiry = self.node._clock.now_ns() + lifespan if lifespan is not None else None
         meta = (time.time_ns(), self.published, expiry)
         if self._history is not None:
             self._history.append((msg, meta))
-        self._fan_out(_deliver_all, msg, meta)
+        self._fan_out(msg, meta)
 
     def _accept(self, msg: M) -> M:
         """The checks and the copy every publish makes: the type, a destroyed publisher, the
@@ -270,15 +270,20 @@ class Publisher(Endpoint, Generic[M]):
             )
         return msg
 
-    def _fan_out(self, deliver: Callable[..., None], msg: Any, *meta: Any) -> None:
-        """Run ``deliver(subscriptions, msg, *meta)`` on each matched loop: inline for this loop's
-        subscriptions when called on its thread, posted otherwise; taps take ``msg`` inline."""
+    def _fan_out(self, msg: Any, meta: Any = None) -> None:
+        """Hand ``msg`` (with ``meta``, the MessageInfo data, when not None) to every matched
+        subscription: inline for this loop's when called on its thread, posted to the others'
+        loops; taps take ``msg`` inline."""
         if threading.get_ident() == self._thread_id:
-            deliver(self._same_loop, msg, *meta)
+            if meta is None:
+                for sub in self._same_loop:
+                    sub._enqueue(msg)
+            else:
+                _deliver_all(self._same_loop, msg, meta)
         elif self._same_loop and self._own_loop is not None:
-            post(self._own_loop, deliver, self._same_loop, msg, *meta)
+            _post_to(self._own_loop, self._same_loop, msg, meta)
         for loop, subs in self._other_loops:
-            post(loop, deliver, subs, msg, *meta)
+            _post_to(loop, subs, msg, meta)
         for tap in self._taps:
             tap._enqueue(msg)
 
@@ -337,6 +342,13 @@ def _deliver_all(subs: tuple[Subscription, ...], msg: Any, meta: Any) -> None:
 def _enqueue_all(subs: tuple[Subscription, ...], msg: Any) -> None:
     for sub in subs:
         sub._enqueue(msg)
+
+
+def _post_to(loop: asyncio.AbstractEventLoop, subs: tuple[Subscription, ...], msg: Any, meta: Any) -> None:
+    if meta is None:
+        post(loop, _enqueue_all, subs, msg)
+    else:
+        post(loop, _deliver_all, subs, msg, meta)
 
 
 class Tap(Endpoint):
