@@ -201,10 +201,14 @@ class Player(Node):
         self.rate = float(rate)  # the playback rebases at the current position: no jump
 
     def seek(self, t_ns: int) -> None:
-        """Go on from bag time ``t_ns`` (clamped to the bag's start and end); paused stays paused."""
+        """Go on from bag time ``t_ns`` (clamped to the bag's start and end); paused stays paused.
+        After the end, a seek plays again from there (once resumed, if paused)."""
         self._seek_to = min(max(int(t_ns), self.reader.start_ns), self.reader.end_ns)
         self._playhead = self._seek_to
         self._kick.set()
+        if self._done.is_set() and self._task is not None:
+            self._done.clear()
+            self._task = self.create_task(self._play(), name=f"aiorobot-player {self.path}")
 
     @property
     def current_time_ns(self) -> int:
@@ -240,6 +244,8 @@ class Player(Node):
         from aiorobot.msgs import deserialize
 
         origin = start = self.reader.start_ns + int(self.start_offset * 1e9)
+        if self._seek_to is not None:  # a seek after the end starts this pass
+            start, self._seek_to = self._seek_to, None
         clock_period_ns = int(1e9 / self.clock_hz)
         turn = time.monotonic_ns()  # when the loop last had a turn
         try:

@@ -84,7 +84,7 @@ async def test_play_pause_seek_and_speed_from_the_playback_bar(tmp_path: Path) -
         assert player.rate == 8.0
 
 
-async def test_player_seeks_while_paused_plays_on_from_there_and_clamps_a_seek_after_the_end(tmp_path: Path) -> None:
+async def test_player_seeks_while_paused_and_after_the_end_and_clamps_to_the_bag(tmp_path: Path) -> None:
     async with Runtime(handle_signals=False) as rt:
         counter = rt.add_node(Counter())
         player = rt.add_node(Player(path=str(_bag(tmp_path, 20)), start_paused=True, rate=20.0))
@@ -94,6 +94,11 @@ async def test_player_seeks_while_paused_plays_on_from_there_and_clamps_a_seek_a
         player.resume()
         assert await player.wait_for_completion(timeout_sec=20)
         assert counter.values == list(range(15, 20))
-        player.seek(T0 - STEP)  # clamped to the bag's start; playback has ended: nothing restarts
+        player.pause()
+        player.seek(T0 + 17 * STEP)  # after the end: plays again from there once resumed
+        assert not player.done and player.current_time_ns == T0 + 17 * STEP
+        player.resume()
+        assert await player.wait_for_completion(timeout_sec=20)
+        assert counter.values == [*range(15, 20), 17, 18, 19]
+        player.seek(T0 - STEP)  # clamped to the bag's start
         assert player.current_time_ns == T0
-        assert counter.values == list(range(15, 20))
