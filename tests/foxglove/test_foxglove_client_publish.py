@@ -4,7 +4,9 @@ and nothing is published."""
 
 from __future__ import annotations
 
+import asyncio
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -31,18 +33,16 @@ class Base(Node):
         self.create_subscription(Twist, "/cmd_vel", self.received.append, 100)
 
 
-async def _poll(rt: Runtime, condition: object, what: str, bound: int = 2000) -> None:
+async def _poll(rt: Runtime, condition: Callable[[], object], what: str, bound: int = 2000) -> None:
     for _ in range(bound):
-        if condition():  # type: ignore[operator]
+        if condition():
             return
         await rt.settle()
-        await __import__("asyncio").sleep(0.01)
+        await asyncio.sleep(0.01)
     raise AssertionError(f"never happened: {what}")
 
 
 async def test_teleop_twist_at_20_hz_arrives_whole_and_in_order() -> None:
-    import asyncio
-
     async with Runtime(handle_signals=False) as rt:
         base = rt.add_node(Base())
         bridge = rt.add_node(FoxgloveBridge(port=0))
