@@ -5,7 +5,12 @@ graph saying who provides what."""
 
 from __future__ import annotations
 
+import asyncio
+import os
+import re
 import struct
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -66,9 +71,10 @@ async def test_parameters_services_and_topics_of_another_process() -> None:
                     return _values(await client.wait_op("parameterValues", lambda d, i=f"get{n}": d.get("id") == i))
 
                 values = await get_all()
-                for _ in range(200):  # until zenoh has told this process of the other node
+                for _ in range(400):  # until zenoh has told this process of the other node (polling, 20 s at most)
                     if "/remote_tuner.gain" in values:
                         break
+                    await asyncio.sleep(0.05)
                     values = await get_all()
                 assert values["/remote_tuner.gain"] == 0.5 and values["/remote_tuner.mode"] == "slow"
                 assert "/foxglove_bridge.port" in values  # and the bridge's own, as before
@@ -104,5 +110,40 @@ async def test_parameters_services_and_topics_of_another_process() -> None:
                 assert call_id == 5
                 assert deserialize(frame[13 + enc_len:], AddTwoInts.Response).sum == 42
     finally:
+        await child.stop()
+        router.close()
+
+
+async def test_the_aiorobot_foxglove_process_shows_another_process_parameters(tmp_path: Path) -> None:
+    port = free_port()
+    router = open_router(port)
+    conf = tmp_path / "zenoh.json5"
+    conf.write_text('{ mode: "peer", connect: { endpoints: ["tcp/127.0.0.1:%d"] }, listen: { endpoints: ["tcp/127.0.0.1:0"] },'
+                    ' scouting: { multicast: { enabled: false } } }' % port)
+    env = {k: v for k, v in os.environ.items() if k != "ZENOH_CONFIG_OVERRIDE"} | {"ZENOH_SESSION_CONFIG_URI": str(conf)}
+    child = await spawn(CHILD, port)
+    bridge = await asyncio.create_subprocess_exec(sys.executable, "-m", "aiorobot.cli", "foxglove", "--port", "0", env=env,
+                                                  stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.PIPE)
+    try:
+        await child.expect("READY")
+        assert bridge.stderr is not None
+        async with asyncio.timeout(30):
+            found = None
+            while found is None:
+                line = (await bridge.stderr.readline()).decode()
+                assert line, "aiorobot foxglove ended before serving"
+                found = re.search(r"ws://127\.0\.0\.1:(\d+)", line)
+        async with FoxgloveClient(int(found.group(1))) as client:
+            await client.wait_op("serverInfo")
+            for n in range(400):  # until zenoh has told the bridge's process of the other node (polling, 20 s at most)
+                await client.send({"op": "getParameters", "parameterNames": ["/remote_tuner.gain"], "id": str(n)})
+                values = _values(await client.wait_op("parameterValues", lambda d, i=str(n): d.get("id") == i))
+                if values:
+                    break
+                await asyncio.sleep(0.05)
+            assert values == {"/remote_tuner.gain": 0.5}
+    finally:
+        bridge.terminate()
+        await bridge.wait()
         await child.stop()
         router.close()
