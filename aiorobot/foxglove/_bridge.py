@@ -230,6 +230,8 @@ class FoxgloveBridge(Node):
         with self._lock:
             channel = self._channels.get(topic)
             kept = list(self._latched.get(topic, ()))
+        if channel is None:
+            return
         for msg, t_ns in kept:
             self._pending.append((channel, msg, t_ns, client_id))
         if kept:

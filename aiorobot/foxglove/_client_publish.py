@@ -78,10 +78,6 @@ class ClientPublishing:
         if ch is not None:  # an unknown id: the server has told the client already
             self._to_loop(self._deliver, ch, bytes(data))
 
-    def forget_client(self, client_id: int) -> None:
-        for key in [k for k in self._channels if k[0] == client_id]:
-            del self._channels[key]
-
     def _to_loop(self, fn: Any, *args: Any) -> None:
         loop = node_loop(self.bridge)
         if loop is not None:

@@ -29,7 +29,11 @@ class GraphView:
 
     async def run(self) -> None:
         while True:
-            self.refresh()
+            try:
+                self.refresh()
+            except Exception as err:  # noqa: BLE001 - one bad refresh must not end the watch; say so
+                self.bridge.get_logger().warning(f"foxglove: graph refresh failed ({type(err).__name__}: {err})",
+                                                 throttle_duration_sec=10.0)
             await asyncio.sleep(self.period_sec)
 
     def refresh(self) -> None:

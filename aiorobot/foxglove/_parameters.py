@@ -66,7 +66,11 @@ class GraphParameters:
         if loop is None:
             coro.close()
             return []
-        return list(asyncio.run_coroutine_threadsafe(coro, loop).result(timeout=self.timeout_sec * 3 + 5.0))
+        try:
+            return list(asyncio.run_coroutine_threadsafe(coro, loop).result(timeout=self.timeout_sec * 3 + 5.0))
+        except Exception as err:  # noqa: BLE001 - the bridge is stopping, or the graph did not answer: say so
+            self.bridge.error_status(f"foxglove: parameter request failed ({type(err).__name__} {err})".rstrip(), "parameters")
+            return []
 
     # -- on the bridge node's loop ---------------------------------------------------------
 
