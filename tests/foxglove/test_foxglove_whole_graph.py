@@ -6,7 +6,6 @@ graph saying who provides what."""
 from __future__ import annotations
 
 import asyncio
-import os
 import re
 import struct
 import sys
@@ -17,7 +16,7 @@ import pytest
 from aiorobot.foxglove import FoxgloveBridge
 from aiorobot.msgs import deserialize, serialize
 from aiorobot.msgs.example_interfaces import AddTwoInts
-from tests.transport._helpers import free_port, open_router, peer_runtime, spawn
+from tests.transport._helpers import free_port, open_router, peer_env, peer_runtime, spawn
 
 pytest.importorskip("websockets")
 from foxglove_wsclient import SERVICE_RESPONSE, FoxgloveClient  # noqa: E402
@@ -117,10 +116,7 @@ async def test_parameters_services_and_topics_of_another_process() -> None:
 async def test_the_aiorobot_foxglove_process_shows_another_process_parameters(tmp_path: Path) -> None:
     port = free_port()
     router = open_router(port)
-    conf = tmp_path / "zenoh.json5"
-    conf.write_text('{ mode: "peer", connect: { endpoints: ["tcp/127.0.0.1:%d"] }, listen: { endpoints: ["tcp/127.0.0.1:0"] },'
-                    ' scouting: { multicast: { enabled: false } } }' % port)
-    env = {k: v for k, v in os.environ.items() if k != "ZENOH_CONFIG_OVERRIDE"} | {"ZENOH_SESSION_CONFIG_URI": str(conf)}
+    env = peer_env(tmp_path, port)
     child = await spawn(CHILD, port)
     bridge = await asyncio.create_subprocess_exec(sys.executable, "-m", "aiorobot.cli", "foxglove", "--port", "0", env=env,
                                                   stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.PIPE)
