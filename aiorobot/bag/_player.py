@@ -28,6 +28,8 @@ __all__ = ["Player", "PlayerStatistics", "parse_remaps"]
 
 #: The longest the player publishes due messages back to back before giving the loop a turn.
 _YIELD_NS = 2_000_000
+#: the longest the player sleeps before it looks at a new rate or a seek again
+_CONTROL_NS = 50_000_000
 
 
 def parse_remaps(remaps: list[str]) -> dict[str, str]:
@@ -133,6 +135,10 @@ class Player(Node):
         self._resume = asyncio.Event()
         if not start_paused:
             self._resume.set()
+        self._kick = asyncio.Event()  # a resume or a seek wakes a paused playback
+        self._seek_to: int | None = None
+        self._wall0 = time.monotonic_ns()
+        self._base = self._playhead = self.reader.start_ns + int(self.start_offset * 1e9)
         self._done = asyncio.Event()
         self._task: asyncio.Task[None] | None = None
 
@@ -174,10 +180,12 @@ class Player(Node):
     # -- control ------------------------------------------------------------------------
 
     def pause(self) -> None:
+        self._playhead = self.current_time_ns
         self._resume.clear()
 
     def resume(self) -> None:
         self._resume.set()
+        self._kick.set()
 
     def toggle_pause(self) -> bool:
         """Pause if playing, resume if paused; returns True when now paused."""
@@ -190,7 +198,25 @@ class Player(Node):
     def set_rate(self, rate: float) -> None:
         if not rate > 0:
             raise ValueError(f"rate must be > 0, found {rate!r}")
-        self.rate = float(rate)
+        self.rate = float(rate)  # the playback rebases at the current position: no jump
+
+    def seek(self, t_ns: int) -> None:
+        """Go on from bag time ``t_ns`` (clamped to the bag's start and end); paused stays paused.
+        After the end, a seek plays again from there (once resumed, if paused)."""
+        self._seek_to = min(max(int(t_ns), self.reader.start_ns), self.reader.end_ns)
+        self._playhead = self._seek_to
+        self._kick.set()
+        if self._done.is_set() and self._task is not None:
+            self._done.clear()
+            self._task = self.create_task(self._play(), name=f"aiorobot-player {self.path}")
+
+    @property
+    def current_time_ns(self) -> int:
+        """The bag time playback has reached (the recorded time of what plays next, while paused)."""
+        if not self._resume.is_set() or self.done or self._seek_to is not None:
+            return self._playhead
+        elapsed = int((time.monotonic_ns() - self._wall0) * self.rate)
+        return min(max(self._base + elapsed, self._playhead), self.reader.end_ns)
 
     @property
     def done(self) -> bool:
@@ -217,22 +243,35 @@ class Player(Node):
     async def _play(self) -> None:
         from aiorobot.msgs import deserialize
 
-        start = self.reader.start_ns + int(self.start_offset * 1e9)
+        origin = start = self.reader.start_ns + int(self.start_offset * 1e9)
+        if self._seek_to is not None:  # a seek after the end starts this pass
+            start, self._seek_to = self._seek_to, None
         clock_period_ns = int(1e9 / self.clock_hz)
         turn = time.monotonic_ns()  # when the loop last had a turn
         try:
             while True:
-                wall_t0 = time.monotonic_ns()
+                wall_t0 = self._wall0 = time.monotonic_ns()
+                base = self._base = start  # bag time played at wall_t0
+                rate = self.rate
                 last_clock = wall_t0 - clock_period_ns
                 played = self._published + self._skipped
+                seek: int | None = None
                 for topic, t_ns, data in self.reader.messages(list(self._types), start_ns=start):
                     while True:  # pace: wait for the message's time, publishing /clock meanwhile
-                        if not self._resume.is_set():
+                        while not self._resume.is_set() and self._seek_to is None:
                             paused_at = time.monotonic_ns()
-                            await self._resume.wait()
-                            wall_t0 += time.monotonic_ns() - paused_at
+                            self._kick.clear()
+                            await self._kick.wait()
+                            wall_t0 = self._wall0 = wall_t0 + time.monotonic_ns() - paused_at
+                        if self._seek_to is not None:
+                            seek, self._seek_to = self._seek_to, None
+                            break
                         now = time.monotonic_ns()
-                        due = wall_t0 + int((t_ns - start) / self.rate)
+                        if self.rate != rate:  # rebase at the current position: a new rate does not jump
+                            base = self._base = base + int((now - wall_t0) * rate)
+                            wall_t0 = self._wall0 = now
+                            rate = self.rate
+                        due = wall_t0 + int((t_ns - base) / rate)
                         if now >= due:
                             if now - turn >= _YIELD_NS:  # behind schedule: still let the loop run
                                 await asyncio.sleep(0)
@@ -241,11 +280,14 @@ class Player(Node):
                         wake = due
                         if self._clock_pub is not None:
                             if now - last_clock >= clock_period_ns:
-                                self._publish_clock(start + int((now - wall_t0) * self.rate))
+                                self._publish_clock(base + int((now - wall_t0) * rate))
                                 last_clock = now
                             wake = min(due, last_clock + clock_period_ns)
-                        await self._sleep_until_ns(wake)
+                        await self._sleep_until_ns(min(wake, now + _CONTROL_NS))
                         turn = time.monotonic_ns()
+                    if seek is not None:
+                        break
+                    self._playhead = t_ns
                     if self._clock_pub is not None:
                         self._publish_clock(t_ns)
                     try:
@@ -262,9 +304,13 @@ class Player(Node):
                     matched = pub.get_subscription_count()
                     if matched > self._matched.get(topic, 0):
                         self._matched[topic] = matched
+                if seek is not None:
+                    start = seek
+                    continue
                 self._loops += 1
                 if not self.loop or self._published + self._skipped == played:  # nothing to play again
                     break
+                start = origin
                 await asyncio.sleep(0)  # a pass may have taken no time at all: the loop gets a turn
                 turn = time.monotonic_ns()
         finally:

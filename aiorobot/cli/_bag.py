@@ -68,6 +68,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     play.add_argument("--topics", nargs="+", default=[], metavar="TOPIC", help="play only these topics")
     play.add_argument("--remap", nargs="+", type=_remap, default=[], metavar="FROM:=TO", help="publish FROM as TO")
     play.add_argument("--start-paused", action="store_true", help="start paused (space to resume when a terminal is attached)")
+    from ._foxglove import port_number
+
+    play.add_argument("--foxglove", nargs="?", type=port_number, const=8765, default=None, metavar="PORT",
+                      help="serve the playback to Foxglove on PORT (default 8765): play, pause, seek and speed from its playback bar")
     _transport_args(play)
 
     info = sub.add_parser("info", help="what a bag holds", description="Print a bag's files, time range and topics (ros2 bag info).")
@@ -225,11 +229,18 @@ async def _play(args: argparse.Namespace) -> int:
             start_paused=args.start_paused,
         )
         rt.add_node(player)
+        if args.foxglove is not None:
+            from aiorobot.foxglove import FoxgloveBridge
+
+            bridge = rt.add_node(FoxgloveBridge(port=args.foxglove, player=player))
+            print(f"Foxglove: open ws://127.0.0.1:{bridge.bound_port}; its playback bar controls this player "
+                  "(Ctrl-C to stop)", file=sys.stderr)
         keys = _Keyboard(player) if sys.stdin.isatty() else None
         try:
             done = asyncio.ensure_future(player.wait_for_completion())
             stop = asyncio.ensure_future(rt.spin())
-            await asyncio.wait({done, stop}, return_when=asyncio.FIRST_COMPLETED)
+            # with Foxglove, the end of the bag does not end the process: the app may seek back (Ctrl-C stops)
+            await asyncio.wait({stop} if args.foxglove is not None else {done, stop}, return_when=asyncio.FIRST_COMPLETED)
             for fut in (done, stop):
                 fut.cancel()
         finally:

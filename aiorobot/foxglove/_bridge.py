@@ -1,9 +1,21 @@
-"""``FoxgloveBridge``: a Foxglove WebSocket server (foxglove-sdk) showing a running graph live.
+"""``FoxgloveBridge``: a Foxglove WebSocket server (foxglove-sdk) showing a running graph live and
+taking commands from it.
 
 Every topic becomes a channel with its ``ros2msg`` schema and CDR messages, so Foxglove's ROS
 panels (3D with ``/tf`` and ``/tf_static``, Image, Plot, Raw Messages) work as they do with a
-ROS 2 bridge. Node parameters appear under ``/<node>.<name>`` and services can be called from
-the app.
+ROS 2 bridge. The server's capabilities, each in its own module:
+
+- ``clientPublish`` (:mod:`._client_publish`): the teleop panel's Twist, "Publish pose" on
+  ``/goal_pose`` and "Publish pose estimate" on ``/initialpose`` reach the graph;
+- ``parameters`` and ``parametersSubscribe`` of every node, in any process (:mod:`._parameters`);
+- ``services`` and ``connectionGraph``, kept current as nodes come and go (:mod:`._graph_view`);
+- ``assets``: ``package://`` and ``file://`` under the configured roots (:mod:`._assets`);
+- ``time``: on sim time, the latest ``/clock`` at 10 Hz or more;
+- ``playbackControl`` when serving a :class:`~aiorobot.bag.Player` (:mod:`._playback`).
+
+A topic published transient local (``/robot_description``, ``/map``, ``/tf_static``) keeps its
+last messages, and a client that subscribes later gets them, to it alone, as a late-joining ROS
+subscriber would.
 
 The control loop must never wait on a viewer: a topic costs its publisher one check while no
 client is subscribed, and otherwise one append to a bounded queue; a bridge thread serialises
@@ -13,17 +25,20 @@ queue drops its oldest entry when a slow client lets it fill.
 
 from __future__ import annotations
 
-import asyncio
 import threading
-
+import time
 from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
 from .._core._node import Node
-from .._core._pubsub import Endpoint, Publisher
-from ..lowlevel import Tap, add_tap, node_loop, remove_tap, watch_publishers
-from .._core._qos import QoSProfile, ReliabilityPolicy
+from .._core._pubsub import Publisher
+from .._core._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ..lowlevel import Tap, add_tap, remove_tap, watch_publishers
+from ._assets import AssetResolver
+from ._client_publish import ClientPublishing
+from ._graph_view import GraphView
+from ._parameters import GraphParameters
 
 __all__ = ["FoxgloveBridge", "FoxgloveStatistics"]
 
@@ -32,17 +47,24 @@ LARGE_BYTES = 64 * 1024
 _LARGE_TYPES = frozenset(
     {"sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage", "sensor_msgs/msg/PointCloud2", "nav_msgs/msg/OccupancyGrid"}
 )
+#: transient-local messages kept per topic for late clients (robot_description, map, tf_static)
+_LATCHED_DEPTH = 16
+#: on sim time, the time is sent again after this long without a new /clock (10 Hz at least)
+_TIME_REPEAT_NS = 100_000_000
 
 
 @dataclass(frozen=True, slots=True)
 class FoxgloveStatistics:
-    """Channels advertised, messages sent to clients, dropped by throttling or a full queue."""
+    """Channels advertised, messages sent to clients, dropped by throttling or a full queue;
+    messages clients published into the graph and refused (unknown topic, bad schema or data)."""
 
     channels: int
     sent: int
     throttled: int
     dropped: int
     port: int
+    client_published: int = 0
+    client_refused: int = 0
 
 
 class FoxgloveBridge(Node):
@@ -50,24 +72,32 @@ class FoxgloveBridge(Node):
 
     Parameters: ``host`` (default 127.0.0.1), ``port`` (default 8765; 0 picks a free port),
     ``max_large_hz`` (per-topic rate limit for images/clouds, default 10), ``queue`` (messages
-    waiting for the bridge thread before the oldest is dropped, default 256).
+    waiting for the bridge thread before the oldest is dropped, default 256), ``asset_roots``
+    (folders ``package://`` and ``file://`` URIs may read from, besides the packages' share
+    folders). ``player``: a :class:`~aiorobot.bag.Player` whose playback the app controls.
     """
 
     def __init__(self, node_name: str = "foxglove_bridge", *, host: str = "127.0.0.1", port: int = 8765,
-                 max_large_hz: float = 10.0, queue: int = 256, **kwargs: Any) -> None:
+                 max_large_hz: float = 10.0, queue: int = 256, asset_roots: list[str] | None = None,
+                 player: Any = None, **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
         self.host = str(self.declare_parameter("host", host).value)
         self.port = int(self.declare_parameter("port", int(port)).value)
         self.max_large_hz = float(self.declare_parameter("max_large_hz", float(max_large_hz)).value)
         self.queue_size = int(self.declare_parameter("queue", int(queue)).value)
+        roots = [r for r in self.declare_parameter("asset_roots", list(asset_roots or [""])).value if r]
         if not 0 <= self.port <= 65535:
             raise ValueError(f"foxglove bridge: port must be 0..65535, found {self.port}")
         if not self.max_large_hz > 0 or self.queue_size < 1:
             raise ValueError("foxglove bridge: max_large_hz must be > 0 and queue >= 1")
+        self.assets = AssetResolver(roots)  # a root that is not a folder fails here
+        self.player = player
         self._lock = threading.Lock()
         self._channels: dict[str, Any] = {}
+        self._latched: dict[str, deque[tuple[Any, int]]] = {}
         self._taps: list[Tap] = []
-        self._pending: deque[tuple[Any, Any, int]] = deque(maxlen=self.queue_size)
+        self._client_pubs: dict[str, Any] = {}
+        self._pending: deque[tuple[Any, Any, int, int | None]] = deque(maxlen=self.queue_size)
         self._wake = threading.Event()
         self._halt = threading.Event()
         self._thread: threading.Thread | None = None
@@ -75,7 +105,13 @@ class FoxgloveBridge(Node):
         self._context: Any = None
         self._unwatch: Any = None
         self._sent = self._throttled = self._dropped = 0
-        self._services_added: set[str] = set()
+        self._sim_time = False
+        self._clock_ns: int | None = None
+        self._told_clock = False
+        self.client_publishing = ClientPublishing(self)
+        self.parameters = GraphParameters(self)
+        self.graph_view = GraphView(self)
+        self.playback: Any = None
 
     def __repr__(self) -> str:
         return f"<FoxgloveBridge ws://{self.host}:{self.bound_port} channels={len(self._channels)}>"
@@ -84,8 +120,15 @@ class FoxgloveBridge(Node):
     def bound_port(self) -> int:
         return int(self._server.port) if self._server is not None else self.port
 
+    @property
+    def server(self) -> Any:
+        """foxglove-sdk's ``WebSocketServer`` while serving, else None."""
+        return self._server
+
     def statistics(self) -> FoxgloveStatistics:
-        return FoxgloveStatistics(len(self._channels), self._sent, self._throttled, self._dropped, self.bound_port)
+        cp = self.client_publishing
+        return FoxgloveStatistics(len(self._channels), self._sent, self._throttled, self._dropped, self.bound_port,
+                                  cp.published, cp.refused)
 
     # -- lifecycle ----------------------------------------------------------------------
 
@@ -98,25 +141,43 @@ class FoxgloveBridge(Node):
         import foxglove
         from foxglove.websocket import Capability
 
+        from ._listener import make_listener
+
+        self._sim_time = bool(self.runtime.use_sim_time or self.get_parameter("use_sim_time").value)
+        capabilities = [Capability.ClientPublish, Capability.Parameters, Capability.Services, Capability.ConnectionGraph]
+        if self._sim_time:
+            capabilities.append(Capability.Time)
+        time_range = None
+        if self.player is not None:
+            from ._playback import PlaybackControl
+
+            self.playback = PlaybackControl(self, self.player)
+            time_range = self.playback.time_range
         self._context = foxglove.Context()
         try:
             self._server = foxglove.start_server(
                 name=f"aiorobot {self.get_fully_qualified_name()}",
                 host=self.host,
                 port=self.port,
-                capabilities=[Capability.Parameters, Capability.Services],
-                server_listener=_Listener(self),
+                capabilities=capabilities,
+                server_listener=make_listener(self),
                 supported_encodings=["cdr"],
+                asset_handler=self.assets,
                 context=self._context,
+                playback_time_range=time_range,
             )
         except Exception as err:  # port taken, bad host: one line, nothing half-started
             raise OSError(f"foxglove bridge: cannot listen on {self.host}:{self.port} ({err})") from None
         self._thread = threading.Thread(target=self._send_loop, name="aiorobot-foxglove", daemon=True)
         self._thread.start()
+        if self._sim_time:
+            self._tap_clock()
+        self.parameters.start()
         self._unwatch = watch_publishers(self.runtime, self._on_endpoint)
 
     async def on_start(self) -> None:
-        self._refresh_services()
+        self.graph_view.refresh()
+        self.create_task(self.graph_view.run(), name="aiorobot-foxglove graph")
         self.get_logger().info(f"Foxglove: open ws://{self.host}:{self.bound_port} in the Foxglove app")
 
     async def on_shutdown(self) -> None:
@@ -143,15 +204,50 @@ class FoxgloveBridge(Node):
             channel.close()
         self._channels.clear()
 
+    # -- what the capabilities call -------------------------------------------------------
+
+    def error_status(self, message: str, status_id: str) -> None:
+        """Tell the app (an error status) and the log."""
+        from foxglove.websocket import StatusLevel
+
+        self.get_logger().warning(message)
+        if self._server is not None:
+            self._server.publish_status(message, StatusLevel.Error, status_id)
+
+    def remove_status(self, status_id: str) -> None:
+        if self._server is not None:
+            self._server.remove_status([status_id])
+
+    def publisher_for(self, msg_type: Any, topic: str) -> Any:
+        """The bridge's publisher on ``topic`` (one per topic, made on first use; call on the node's loop)."""
+        pub = self._client_pubs.get(topic)
+        if pub is None or pub.msg_type is not msg_type:
+            pub = self._client_pubs[topic] = self.create_publisher(msg_type, topic, 10)
+        return pub
+
+    def replay_latched(self, client_id: int, topic: str) -> None:
+        """Send ``topic``'s kept transient-local messages to one client (it just subscribed)."""
+        with self._lock:
+            channel = self._channels.get(topic)
+            kept = list(self._latched.get(topic, ()))
+        if channel is None:
+            return
+        for msg, t_ns in kept:
+            self._pending.append((channel, msg, t_ns, client_id))
+        if kept:
+            self._wake.set()
+
     # -- topics -------------------------------------------------------------------------
 
-    def _on_endpoint(self, endpoint: Endpoint) -> None:
-        if not isinstance(endpoint, Publisher):
-            return
+    def _on_endpoint(self, endpoint: Publisher[Any]) -> None:
         import foxglove
         from aiorobot.msgs import message_definition
 
         name = endpoint.topic_name
+        if name == "/clock" and not self._sim_time and not self._told_clock:
+            self._told_clock = True
+            self.get_logger().info("the graph publishes /clock but this bridge runs on wall time: start it on sim time "
+                                   "(use_sim_time, `aiorobot foxglove --use-sim-time`) for Foxglove to follow /clock")
         with self._lock:
             if name in self._channels or self._server is None:
                 return
@@ -169,8 +265,13 @@ class FoxgloveBridge(Node):
             pending = self._pending
             wake = self._wake
             clock = self.runtime.clock
+            latched: deque[tuple[Any, int]] | None = None
+            if endpoint.qos.durability == DurabilityPolicy.TRANSIENT_LOCAL:
+                latched = self._latched[name] = deque(maxlen=max(1, min(endpoint.qos.depth, _LATCHED_DEPTH)))
 
             def forward(msg: Any) -> None:
+                if latched is not None:
+                    latched.append((msg, clock.now().nanoseconds))
                 if not channel.has_sinks():
                     return  # nobody watches this topic: cost one check
                 now = clock.now().nanoseconds
@@ -181,7 +282,7 @@ class FoxgloveBridge(Node):
                     last[0] = now
                 if len(pending) == pending.maxlen:
                     self._dropped += 1
-                pending.append((channel, msg, now))
+                pending.append((channel, msg, now, None))
                 wake.set()
 
             qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, durability=endpoint.qos.durability, depth=max(1, endpoint.qos.depth))
@@ -190,165 +291,45 @@ class FoxgloveBridge(Node):
             self._taps.append(tap)
         add_tap(self.runtime, tap)
 
+    def _tap_clock(self) -> None:
+        from aiorobot.msgs.rosgraph_msgs import Clock
+
+        def on_clock(msg: Any) -> None:
+            self._clock_ns = int(msg.clock.sec) * 1_000_000_000 + int(msg.clock.nanosec)
+            self._wake.set()
+
+        tap = Tap(Clock, "/clock", QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1), on_clock,
+                  owner=self.get_fully_qualified_name())
+        tap.node, tap.wants_remote = self, True
+        self._taps.append(tap)
+        add_tap(self.runtime, tap)
+
     def _send_loop(self) -> None:
         from aiorobot.msgs import serialize
 
+        sent_clock: int | None = None
+        sent_clock_at = 0
+        period = 0.05 if (self._sim_time or self.playback is not None) else 0.5
         while not self._halt.is_set():
-            self._wake.wait(0.5)
+            self._wake.wait(period)
             self._wake.clear()
             while self._pending:
                 try:
-                    channel, msg, t_ns = self._pending.popleft()
+                    channel, msg, t_ns, sink = self._pending.popleft()
                 except IndexError:
                     break
                 try:
-                    channel.log(serialize(msg), log_time=t_ns)
+                    channel.log(serialize(msg), log_time=t_ns, sink_id=sink)
                     self._sent += 1
                 except Exception as err:  # a closed channel during shutdown, a message that does not serialise
                     self.get_logger().warning(f"foxglove: cannot send on {channel.topic} ({err})", throttle_duration_sec=5.0)
-
-    # -- parameters and services ----------------------------------------------------------
-
-    def _nodes(self) -> list[Node]:
-        return list(self.runtime.nodes) if self.executor is not None else []
-
-    def _get_parameters(self, names: list[str]) -> list[Any]:
-        from foxglove.websocket import Parameter
-
-        out = []
-        for node in self._nodes():
-            prefix = node.get_fully_qualified_name()
-            for pname in node.list_parameters().names:
-                full = f"{prefix}.{pname}"
-                if names and full not in names:
-                    continue
-                value = node.get_parameter(pname).value
-                out.append(Parameter(full, value=_to_foxglove(value)))
-        return out
-
-    def _set_parameters(self, params: list[Any]) -> list[Any]:
-        from aiorobot import Parameter as AParameter
-
-        by_node = {n.get_fully_qualified_name(): n for n in self._nodes()}
-        for p in params:
-            node_name, _, pname = p.name.rpartition(".")
-            node = by_node.get(node_name)
-            if node is None:
+            server = self._server
+            if server is None:
                 continue
-            value = _from_foxglove(p.get_value())
-            fut = asyncio.run_coroutine_threadsafe(_set(node, AParameter(pname, value)), node_loop(node))  # type: ignore[arg-type]
-            try:
-                fut.result(timeout=5.0)
-            except Exception as err:
-                self.get_logger().warning(f"foxglove: setting {p.name} failed ({err})")
-        return self._get_parameters([p.name for p in params])
-
-    def _refresh_services(self) -> None:
-        """Offer every service of the graph to the app (request/response as ros2msg + CDR)."""
-        from foxglove.websocket import MessageSchema, Service, ServiceSchema
-
-        import foxglove
-        from aiorobot.msgs import get, message_definition
-
-        if self._server is None:
-            return
-        new = []
-        for name, type_name in self._service_names():
-            if name in self._services_added:
-                continue
-            srv = get(type_name)
-
-            def schema(t: Any) -> Any:
-                tn = str(t.__msgtype__)
-                return MessageSchema(encoding="cdr", schema=foxglove.Schema(name=tn, encoding="ros2msg", data=message_definition(tn).encode()))
-
-            handler = _ServiceHandler(self, name, srv)
-            new.append(Service(name, schema=ServiceSchema(type_name, request=schema(srv.Request), response=schema(srv.Response)), handler=handler))
-            self._services_added.add(name)
-        if new:
-            self._server.add_services(new)
-
-    def _service_names(self) -> list[tuple[str, str]]:
-        graph = self.runtime.graph
-        out = []
-        for svc in graph.services:
-            if svc.servers and svc.types:
-                out.append((svc.name, svc.types[0]))
-        return out
-
-
-async def _set(node: Node, param: Any) -> None:
-    results = node.set_parameters([param])
-    if results and not results[0].successful:
-        raise ValueError(results[0].reason)
-
-
-class _ServiceHandler:
-    """Calls a graph service for the app: CDR request in, CDR response out (in the server's thread)."""
-
-    def __init__(self, bridge: FoxgloveBridge, name: str, srv: Any) -> None:
-        self.bridge = bridge
-        self.name = name
-        self.srv = srv
-        self.client: Any = None
-
-    def __call__(self, request: Any) -> bytes:
-        from aiorobot.msgs import deserialize, serialize
-
-        req = deserialize(bytes(request.payload), self.srv.Request)
-        loop = node_loop(self.bridge)
-        assert loop is not None
-
-        async def call() -> Any:
-            if self.client is None:
-                self.client = self.bridge.create_client(self.srv, self.name)
-            return await self.client.call(req, timeout_sec=10.0)
-
-        response = asyncio.run_coroutine_threadsafe(call(), loop).result(timeout=15.0)
-        return serialize(response)
-
-
-def _Listener(bridge: FoxgloveBridge) -> Any:  # noqa: N802 - builds the listener class lazily (foxglove import)
-    from foxglove.websocket import ServerListener
-
-    class Listener(_ParameterListener, ServerListener):
-        pass
-
-    return Listener(bridge)
-
-
-class _ParameterListener:
-    """foxglove-sdk's ServerListener for parameters (names ``/<node>.<parameter>``)."""
-
-    def __init__(self, bridge: FoxgloveBridge) -> None:
-        self.bridge = bridge
-
-    def on_get_parameters(self, client: Any, param_names: list[str], request_id: str | None = None) -> list[Any]:
-        return self.bridge._get_parameters(list(param_names))
-
-    def on_set_parameters(self, client: Any, parameters: list[Any], request_id: str | None = None) -> list[Any]:
-        return self.bridge._set_parameters(list(parameters))
-
-
-def _to_foxglove(value: Any) -> Any:
-    from foxglove.websocket import ParameterValue
-
-    if isinstance(value, bool):
-        return ParameterValue.Bool(value)
-    if isinstance(value, int):
-        return ParameterValue.Integer(value)
-    if isinstance(value, float):
-        return ParameterValue.Float64(value)
-    if isinstance(value, str):
-        return ParameterValue.String(value)
-    if isinstance(value, (list, tuple)):
-        return ParameterValue.Array([_to_foxglove(v) for v in value])
-    return ParameterValue.String(repr(value))
-
-
-def _from_foxglove(value: Any) -> Any:
-    if isinstance(value, list):
-        return [_from_foxglove(v) for v in value]
-    return value
-
-
+            now = time.monotonic_ns()
+            clock_ns = self._clock_ns
+            if clock_ns is not None and (clock_ns != sent_clock or now - sent_clock_at >= _TIME_REPEAT_NS):
+                server.broadcast_time(clock_ns)
+                sent_clock, sent_clock_at = clock_ns, now
+            if self.playback is not None:
+                self.playback.tick(server)

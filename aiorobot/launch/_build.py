@@ -73,7 +73,8 @@ def build_nodes(config: GraphConfig, process: str = MAIN_PROCESS) -> list[tuple[
         from aiorobot.foxglove import FoxgloveBridge
 
         fox = config.foxglove
-        built.append((FoxgloveBridge(host=fox.host, port=fox.port, max_large_hz=fox.max_large_hz), "main"))
+        built.append((FoxgloveBridge(host=fox.host, port=fox.port, max_large_hz=fox.max_large_hz,
+                                     asset_roots=list(fox.asset_roots)), "main"))
     return built
 
 

@@ -70,7 +70,7 @@ _NODE_KEYS = (
 #: what a node's failure to start does to the run (``[[nodes]] on_failure``)
 ON_FAILURE = ("stop", "continue", "restart")
 _RECORD_KEYS = ("path", "topics", "exclude", "compression", "max_bag_size", "max_bag_duration", "max_cache_size")
-_FOXGLOVE_KEYS = ("host", "port", "max_large_hz")
+_FOXGLOVE_KEYS = ("host", "port", "max_large_hz", "asset_roots")
 _TOP_KEYS = ("runtime", "nodes", "record", "processes")
 #: ``[processes.<name>] restart``: when the supervisor starts a process again after it ended
 RESTART_POLICIES = ("no", "on-failure", "always")
@@ -160,11 +160,13 @@ class RecordConfig:
 
 @dataclass(frozen=True, slots=True)
 class FoxgloveConfig:
-    """``[runtime] foxglove = true`` or ``{ port = 8765, host = "127.0.0.1", max_large_hz = 10 }``."""
+    """``[runtime] foxglove = true`` or ``{ port = 8765, host = "127.0.0.1", max_large_hz = 10,
+    asset_roots = ["meshes"] }`` (folders relative to the config file)."""
 
     host: str = "127.0.0.1"
     port: int = 8765
     max_large_hz: float = 10.0
+    asset_roots: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -581,7 +583,16 @@ def _parse_foxglove(checker: _Checker, value: Any) -> FoxgloveConfig | None:
     checker.check_type(hz, f"{key}.max_large_hz", (int, float), "a rate in Hz > 0")
     if not hz > 0:
         raise checker.error(f"{key}.max_large_hz", f"expected a rate in Hz > 0, found {hz}")
-    return FoxgloveConfig(host, port, float(hz))
+    roots = value.get("asset_roots", [])
+    checker.check_type(roots, f"{key}.asset_roots", list, "a list of folders")
+    resolved = []
+    for i, root in enumerate(roots):
+        checker.check_type(root, f"{key}.asset_roots[{i}]", str, "a folder path")
+        folder = (Path(checker.path).resolve().parent / root).resolve()
+        if not folder.is_dir():
+            raise checker.error(f"{key}.asset_roots[{i}]", f"expected a folder, found no folder at {folder}")
+        resolved.append(str(folder))
+    return FoxgloveConfig(host, port, float(hz), tuple(resolved))
 
 
 class _Checker:

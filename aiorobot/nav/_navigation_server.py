@@ -12,6 +12,10 @@ wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason
 map or in an obstacle is aborted at once with Nav2's error code and message; a cancel stops the
 base and ends CANCELED; no ``/map`` within ``map_timeout`` aborts.
 
+A ``geometry_msgs/PoseStamped`` on ``goal_pose`` (the topic RViz's and Foxglove's "2D Goal Pose"
+publish) is sent as a ``navigate_to_pose`` goal to this node's own action server, as Nav2's
+bt_navigator does; a goal refused (one is already running) is logged.
+
 Localisation lost: the pose estimate on ``localization_topic`` (AMCL's ``amcl_pose``, a
 PoseWithCovarianceStamped; ``localization_type = "odometry"`` for an EKF's nav_msgs/Odometry) with a position standard deviation above
 ``max_localization_std`` (m) or a heading one above ``max_localization_yaw_std`` (rad) stops the
@@ -161,6 +165,10 @@ class NavigationServer(Node):
         self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(ComputePathToPose, "compute_path_to_pose", self._compute_path, cancel_callback=_accept_cancel)
+        self._self_client = self.create_action_client(NavigateToPose, "navigate_to_pose")
+        from aiorobot.msgs.geometry_msgs import PoseStamped
+
+        self.create_subscription(PoseStamped, "goal_pose", self._on_goal_pose, 10)
         self.last_plan: Plan | None = None
         self.recoveries = 0
 
@@ -230,6 +238,14 @@ class NavigationServer(Node):
         from aiorobot import GoalResponse
 
         return GoalResponse.REJECT if self._busy else GoalResponse.ACCEPT
+
+    async def _on_goal_pose(self, pose: Any) -> None:
+        """bt_navigator's onGoalPoseReceived: the pose becomes a navigate_to_pose goal of our own server."""
+        from aiorobot.msgs.nav2_msgs import NavigateToPose
+
+        handle = await self._self_client.send_goal(NavigateToPose.Goal(pose=pose))
+        if not handle.accepted:
+            self.get_logger().warning("goal_pose: navigate_to_pose refused the goal (one is already running)")
 
     # -- actions ------------------------------------------------------------------------
 

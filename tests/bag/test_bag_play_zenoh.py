@@ -8,14 +8,13 @@ it when the publisher appears, so the topic is in its graph and its messages dec
 from __future__ import annotations
 
 import asyncio
-import os
 import sys
 from pathlib import Path
 from typing import Any
 
 from aiorobot import Node, QoSProfile, ReliabilityPolicy
 from aiorobot.msgs import get
-from tests.transport._helpers import free_port, open_router, peer_runtime, wait_until
+from tests.transport._helpers import free_port, open_router, peer_env, peer_runtime, wait_until
 
 from ._ros2_bags import BagTopic, ros2_bag
 
@@ -45,10 +44,7 @@ async def test_a_type_only_the_bag_defines_reaches_another_process_over_zenoh(tm
     bag = _bag(tmp_path)
     port = free_port()
     router = open_router(port)
-    conf = tmp_path / "zenoh.json5"
-    conf.write_text('{ mode: "peer", connect: { endpoints: ["tcp/127.0.0.1:%d"] }, listen: { endpoints: ["tcp/127.0.0.1:0"] },'
-                    ' scouting: { multicast: { enabled: false } } }' % port)
-    env = {k: v for k, v in os.environ.items() if k != "ZENOH_CONFIG_OVERRIDE"} | {"ZENOH_SESSION_CONFIG_URI": str(conf)}
+    env = peer_env(tmp_path, port)
     player = await asyncio.create_subprocess_exec(sys.executable, "-m", "aiorobot.cli", "bag", "play", str(bag), "--loop",
                                                   env=env, stdout=asyncio.subprocess.DEVNULL, stderr=asyncio.subprocess.DEVNULL)
     got: list[Any] = []

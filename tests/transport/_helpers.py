@@ -13,7 +13,7 @@ from typing import Any
 from aiorobot import Runtime
 from aiorobot.transport import ZenohTransport
 
-__all__ = ["Child", "free_port", "open_router", "peer_runtime", "spawn", "wait_until"]
+__all__ = ["Child", "free_port", "open_router", "peer_env", "peer_runtime", "spawn", "wait_until"]
 
 
 def free_port() -> int:
@@ -31,6 +31,15 @@ def open_router(port: int) -> Any:
     cfg.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
     cfg.insert_json5("scouting/multicast/enabled", "false")
     return zenoh.open(cfg)
+
+
+def peer_env(folder: Any, port: int) -> dict[str, str]:
+    """The environment of an ``aiorobot`` command run as a peer of the router on ``port`` (a
+    session config file written into ``folder``, multicast scouting off)."""
+    conf = folder / "zenoh.json5"
+    conf.write_text('{ mode: "peer", connect: { endpoints: ["tcp/127.0.0.1:%d"] }, listen: { endpoints: ["tcp/127.0.0.1:0"] },'
+                    ' scouting: { multicast: { enabled: false } } }' % port)
+    return {k: v for k, v in os.environ.items() if k != "ZENOH_CONFIG_OVERRIDE"} | {"ZENOH_SESSION_CONFIG_URI": str(conf)}
 
 
 def peer_runtime(port: int, *, domain_id: int = 0, **kw: Any) -> Runtime:
