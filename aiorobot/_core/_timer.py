@@ -301,6 +301,9 @@ class Timer:
             self._restart = False
             deadline = self._next_ns
             assert deadline is not None
+            watch = node._late_watch
+            if watch is not None and not node._clock.use_sim_time:
+                watch.arm(id(self), deadline)
             try:
                 await self._sleep_until(deadline)
             except ClockJump:
@@ -343,6 +346,9 @@ class Timer:
         self._lateness.append(late)
         if late > self._max_late:
             self._max_late = late
+        watch = self.node._late_watch
+        if watch is not None:
+            watch.fired(id(self), deadline_ns, late)
 
     def destroy(self) -> None:
         self.node.destroy_timer(self)
