@@ -21,8 +21,10 @@ that keeps the GIL), on the main loop or in a thread of one's own.
    the holder has only just let go and still sits in the function that made the call.
    The culprit is named by the innermost frame of code that is neither the standard
    library, an installed package nor aiorobot (the callback, not ``numpy/...``), with
-   the node and entity when it ran as a node callback; an event loop's thread with no
-   node callback on it is ``(main loop between callbacks)`` (its own I/O and timers).
+   the node and entity when it ran as a node callback. When an event loop's thread ran
+   most but its callback has already returned, the node callback that ran longest on
+   that loop since step 2 is named (the runtime keeps each node's last one); with none,
+   ``(main loop between callbacks)`` (the loop's own I/O and timers).
 5. When the timer fires, its lateness is added to that culprit.
 
 Watching a deadline costs two wake-ups of the sampler; deadlines closer together than
@@ -35,12 +37,15 @@ Timers on sim time are not watched.
 
 from __future__ import annotations
 
+import functools
+import inspect
 import os
 import sys
 import sysconfig
 import threading
 import time
 from dataclasses import dataclass
+from collections.abc import Callable
 from types import FrameType
 from typing import Any
 
@@ -105,6 +110,18 @@ def _is_user_code(filename: str) -> bool:
     return not os.path.realpath(filename).startswith(_LIBRARY_DIRS)
 
 
+def name_callback(entity: Any) -> tuple[str, str]:
+    """``(function, "file:line")`` of an entity's callback (where it is defined)."""
+    fn = getattr(entity, "callback", None) or getattr(entity, "handler", None)
+    while isinstance(fn, functools.partial):
+        fn = fn.func
+    fn = inspect.unwrap(fn) if callable(fn) else fn
+    code = getattr(getattr(fn, "__func__", fn), "__code__", None)
+    if code is None:
+        return type(entity).__name__, ""
+    return getattr(code, "co_qualname", code.co_name), f"{os.path.basename(code.co_filename)}:{code.co_firstlineno}"
+
+
 def name_frame(frame: FrameType | None) -> tuple[str, str, str, str]:
     """``(function, "file:line", node, entity)`` for the code running in ``frame``'s thread."""
     if frame is None:
@@ -136,16 +153,21 @@ class LateWatch:
     def __init__(
         self, late_threshold_sec: float, loop_thread_id: int, loop_name: str = "priority",
         loops: dict[int, str] | None = None,
+        recent: Callable[[str, int], tuple[Any, Any, int] | None] | None = None,
     ) -> None:
         self.threshold_ns = round(late_threshold_sec * 1e9)
         self.loop_thread_id = loop_thread_id
         self.loop_name = loop_name
         #: thread id -> loop name of the event-loop threads (the watched one included)
         self.loops = {**(loops or {}), loop_thread_id: loop_name}
+        #: ``recent(loop, since_ns)``: the node callback that ran longest on that loop since then
+        self._recent = recent
         #: timer key -> its next deadline (monotonic ns), written by the loop's timers
         self._armed: dict[int, int] = {}
         #: timer key -> (deadline, lateness ns) of its last call
         self._fired: dict[int, tuple[int, int]] = {}
+        #: timer key -> the entity name of that timer (``timer 0.02s``)
+        self._entities: dict[int, str] = {}
         self._wake = threading.Event()
         self._idle = False
         self._closed = False
@@ -165,14 +187,17 @@ class LateWatch:
 
     # -- the loop's side (cheap: dict stores) -----------------------------------------------------
 
-    def arm(self, key: int, deadline_ns: int) -> None:
-        """A timer of the loop waits for ``deadline_ns`` (``time.monotonic_ns``)."""
+    def arm(self, key: int, deadline_ns: int, entity: str = "") -> None:
+        """A timer of the loop (``entity``: how ``blocked_at`` names it) waits for ``deadline_ns``."""
         self._armed[key] = deadline_ns
+        if entity:
+            self._entities[key] = entity
         if self._idle:
             self._wake.set()
 
     def disarm(self, key: int) -> None:
         self._armed.pop(key, None)
+        self._entities.pop(key, None)
 
     def fired(self, key: int, deadline_ns: int, late_ns: int) -> None:
         """The timer ``key`` started its callback ``late_ns`` after ``deadline_ns``."""
@@ -206,7 +231,7 @@ class LateWatch:
 
     def _main(self) -> None:
         last = 0
-        previous: dict[int, int] = {}
+        previous: tuple[int, dict[int, int]] | None = None
         gap = round(MIN_GAP_SEC * 1e9)
         lead = round(LEAD_SEC * 1e9)
         while not self._closed:
@@ -221,11 +246,11 @@ class LateWatch:
             key, deadline = pick
             last = deadline
             _sleep_until(deadline - lead)
-            now = self._cpu_times()
+            now = (time.monotonic_ns(), self._cpu_times())
             # A late read means a thread held the GIL across the lead (a long C call): measure
             # from the previous read instead, which that call's CPU time comes after.
-            late_read = time.monotonic_ns() - (deadline - lead) > self.threshold_ns
-            before = previous if late_read and previous else now
+            late_read = now[0] - (deadline - lead) > self.threshold_ns
+            before = previous if late_read and previous is not None else now
             previous = now
             _sleep_until(deadline + self.threshold_ns)
             done = self._fired.get(key)
@@ -233,7 +258,7 @@ class LateWatch:
                 continue  # on time (or the timer moved on)
             if self._armed.get(key, deadline) != deadline and (done is None or done[0] < deadline):
                 continue  # reset or cancelled meanwhile
-            blame = self._sample(before)
+            blame = self._sample(before, key, deadline)
             late = self._wait_fired(key, deadline)
             if late is not None and late > self.threshold_ns:
                 self._add(blame, late)
@@ -262,27 +287,46 @@ class LateWatch:
             self._clock_ids = {k: v for k, v in self._clock_ids.items() if k in times}
         return times
 
-    def _sample(self, before: dict[int, int]) -> tuple[str, str, str, str, str]:
-        """``(function, where, node, entity, thread)`` of the thread that ran most since ``before``."""
+    def _sample(self, start: tuple[int, dict[int, int]], key: int, deadline: int) -> tuple[str, str, str, str, str]:
+        """``(function, where, node, entity, thread)`` of the thread that ran most since ``start``.
+
+        The watched loop's own thread is passed over once the late timer has fired and what it
+        ran is that timer's callback or the loop's own work: that CPU time came after the
+        lateness, not before it (a loaded machine delays the sampler too).
+        """
+        since, before = start
         after = self._cpu_times()
+        done = self._fired.get(key)
+        fired = done is not None and done[0] >= deadline
         frames = sys._current_frames()
-        best, ran = None, 0
-        for ident, cpu in after.items():
-            grew = cpu - before.get(ident, cpu)
-            if grew > ran:
-                best, ran = ident, grew
-        if best is None or ran < self.threshold_ns // 4:
-            return NO_PYTHON, "", "", "", ""
-        frame = frames.get(best)
-        loop = self.loops.get(best)
-        if loop is not None:
-            thread = f"{loop} loop"
-            if not blocked_at(frame)[0]:  # no node callback on it: the loop's own work (I/O, timers)
-                return f"({loop} loop between callbacks)", "", "", "", thread
-        else:
-            thread = {t.ident: t.name for t in threading.enumerate()}.get(best, str(best))
-        function, where, node, entity = name_frame(frame)
-        return function, where, node, entity, thread
+        grown = sorted(((cpu - before.get(ident, cpu), ident) for ident, cpu in after.items()), reverse=True)
+        for ran, ident in grown:
+            if ran < self.threshold_ns // 4:
+                break
+            blame = self._name(ident, frames.get(ident), since)
+            if fired and ident == self.loop_thread_id and (blame[2] == "" or blame[3] == self._entities.get(key)):
+                continue
+            return blame
+        return NO_PYTHON, "", "", "", ""
+
+    def _name(self, ident: int, frame: FrameType | None, since: int) -> tuple[str, str, str, str, str]:
+        loop = self.loops.get(ident)
+        if loop is None:
+            thread = {t.ident: t.name for t in threading.enumerate()}.get(ident, str(ident))
+            return (*name_frame(frame), thread)
+        thread = f"{loop} loop"
+        if blocked_at(frame)[0]:
+            return (*name_frame(frame), thread)
+        # the callback returned before the sampler got the GIL: the one that ran longest on that
+        # loop meanwhile; with none, the loop's own work (I/O, timers)
+        found = self._recent(loop, since) if self._recent is not None else None
+        if found is None or found[2] < self.threshold_ns // 4:
+            return f"({loop} loop between callbacks)", "", "", "", thread
+        from ._node import _describe
+
+        node, entity, _ = found
+        function, where = name_callback(entity)
+        return function, where, node.get_fully_qualified_name(), _describe(entity), thread
 
     def _wait_fired(self, key: int, deadline: int) -> int | None:
         """The lateness of the timer's call for ``deadline`` once it has started; None if it never does."""

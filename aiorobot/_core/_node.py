@@ -80,7 +80,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
     rclpy difference: the ``use_sim_time`` parameter, when nothing sets it, follows
     ``Runtime(use_sim_time=...)`` instead of defaulting to false, so one runtime flag
-    switches every node; ``parameter_overrides`` also takes a ``{name: value}`` mapping.
+    switches every node; ``parameter_overrides`` also takes a ``{name: value}`` mapping; a node
+    with parameter services also serves ``~/get_statistics`` (what ``aiorobot top`` reads).
     """
 
     def __init__(
@@ -138,6 +139,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._started = False
         #: callback statistics per entity (see ``_stats``), filled by ``_invoke``
         self._callback_stats: dict[Any, CallbackRecorder] = {}
+        #: (start ns, end ns, entity) of the node's last finished callback, for the culprit watch
+        self._last_callback: tuple[int, int, Any] | None = None
         self._setup_parameters(automatically_declare_parameters_from_overrides, start_parameter_services)
         if enable_rosout:
             from ..msgs.rcl_interfaces import Log
@@ -719,10 +722,25 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
     def _record_callback(self, entity: Any, start_ns: int) -> None:
         """Count one callback of ``entity`` that started at ``start_ns`` (``time.monotonic_ns``)."""
+        end = time.monotonic_ns()
         recorder = self._callback_stats.get(entity)
         if recorder is None:
             recorder = self._callback_stats[entity] = CallbackRecorder()
-        recorder.add(time.monotonic_ns() - start_ns)
+        recorder.add(end - start_ns)
+        self._last_callback = (start_ns, end, entity)
+
+    async def _timed_call(self, entity: Any, fn: Callable[..., Any], args: tuple[Any, ...], start_deadline: int | None) -> Any:
+        """``fn(*args)``, awaited if it returns an awaitable, its duration counted against ``entity``."""
+        if start_deadline is not None:
+            entity._record_start(start_deadline)
+        start = time.monotonic_ns()
+        try:
+            result = fn(*args)
+            if result is not None and inspect.isawaitable(result):
+                return await result
+            return result
+        finally:
+            self._record_callback(entity, start)
 
     async def _invoke(
         self,
@@ -736,26 +754,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         try:
             if group.exclusive:
                 async with group:
-                    if start_deadline is not None:
-                        entity._record_start(start_deadline)
-                    start = time.monotonic_ns()
-                    try:
-                        result = fn(*args)
-                        if result is not None and inspect.isawaitable(result):
-                            return await result
-                        return result
-                    finally:
-                        self._record_callback(entity, start)
-            if start_deadline is not None:
-                entity._record_start(start_deadline)
-            start = time.monotonic_ns()
-            try:
-                result = fn(*args)
-                if result is not None and inspect.isawaitable(result):
-                    return await result
-                return result
-            finally:
-                self._record_callback(entity, start)
+                    return await self._timed_call(entity, fn, args, start_deadline)
+            return await self._timed_call(entity, fn, args, start_deadline)
         except asyncio.CancelledError:
             raise
         except Exception as err:

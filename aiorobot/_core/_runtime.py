@@ -374,12 +374,27 @@ class Runtime:
             sys.setswitchinterval(min(self._saved_switch_interval, PRIORITY_SWITCH_INTERVAL_SEC))
             if self.late_threshold is not None:
                 loops = {self._thread_id: "main"} if self._thread_id is not None else {}
-                self._late_watch = LateWatch(self.late_threshold, prio.thread_id, loops=loops)
+                self._late_watch = LateWatch(
+                    self.late_threshold, prio.thread_id, loops=loops, recent=self._recent_callback
+                )
         return self._priority
 
     @property
     def priority_loop(self) -> PriorityLoop | None:
         return self._priority
+
+    def _recent_callback(self, executor: str, since_ns: int) -> tuple[Node, Any, int] | None:
+        """The node callback on ``executor``'s loop that ran longest since ``since_ns``: (node, entity, ns)."""
+        best: tuple[Node, Any, int] | None = None
+        now = time.monotonic_ns()
+        for node in list(self._nodes):
+            last = node._last_callback
+            if last is None or node._executor != executor:
+                continue
+            ran = min(last[1], now) - max(last[0], since_ns)
+            if ran > 0 and (best is None or ran > best[2]):
+                best = (node, last[2], ran)
+        return best
 
     @property
     def late_watch(self) -> LateWatch | None:

@@ -28,6 +28,8 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from ._timer import _percentile
+
 if TYPE_CHECKING:
     from ._node import Node
 
@@ -82,12 +84,6 @@ class CallbackRecorder:
             time_p99_sec=_percentile(recent, 0.99) / 1e9,
             time_max_sec=self.max_ns / 1e9,
         )
-
-
-def _percentile(sorted_values: list[int], q: float) -> float:
-    if not sorted_values:
-        return 0.0
-    return float(sorted_values[min(len(sorted_values) - 1, int(q * len(sorted_values)))])
 
 
 def describe_entity(entity: Any) -> tuple[str, str]:
