@@ -17,7 +17,7 @@ import threading
 import time
 from typing import Any
 
-from ._noise import NoiseMeter
+from ._noise import measure_cases
 
 __all__ = ["run", "table"]
 
@@ -71,29 +71,14 @@ async def _measure(case: str, duration_sec: float) -> dict[str, Any]:
     }
 
 
-async def _main(duration_sec: float) -> list[dict[str, Any]]:
-    rows = []
-    for case in CASES:
-        with NoiseMeter() as meter:
-            row = await _measure(case, duration_sec)
-        assert meter.result is not None
-        row["noise"] = meter.result.as_dict()
-        rows.append(row)
-    return rows
-
-
 def run(quick: bool = False) -> dict[str, Any]:
     """Every case; ``{"rows": [...], "watch_cost_pct": on - off, "noise": {...}}``."""
-    import aiorobot
-
-    with NoiseMeter() as meter:
-        rows = aiorobot.run(_main(0.3 if quick else 5.0))
-    assert meter.result is not None
+    rows, noise = measure_cases(_measure, CASES, 0.3 if quick else 5.0)
     return {
         "period_sec": PERIOD_SEC,
         "rows": rows,
         "watch_cost_pct": rows[1]["core_pct"] - rows[0]["core_pct"],
-        "noise": meter.result.as_dict(),
+        "noise": noise,
     }
 
 
