@@ -239,7 +239,7 @@ def _outcome(rt: Runtime) -> int:
     if lines:
         print("failures:\n" + "\n".join(lines), file=sys.stderr)
     if stats["late_periods"]:
-        causes = "".join(f"\n  {c.describe()}" for c in stats["culprits"][:3])
+        causes = "".join(f"\n  {c.describe()}" for c in stats["culprits"])
         print(
             f"late priority periods: {stats['late_periods']} started more than "
             f"{(rt.late_threshold or 0) * 1000:g} ms after their deadline; top causes:{causes}",

@@ -7,6 +7,7 @@ import threading
 import time
 
 from aiorobot import Node, Runtime
+from aiorobot._core._culprit import Culprit
 
 from tests.transport._helpers import wait_until
 
@@ -33,6 +34,14 @@ def _attributed(rt: Runtime, periods: int) -> bool:
     return sum(c.late_periods for c in culprits if not c.function.startswith("(")) >= periods
 
 
+def _top_named(culprits: list[Culprit]) -> Culprit:
+    """The top culprit that is a function: on a loaded machine the OS also makes periods late, which
+    the report shows as ``(no Python thread)`` beside the functions (it names no one)."""
+    named = [c for c in culprits if not c.function.startswith("(")]
+    assert named, [c.describe() for c in culprits]
+    return named[0]
+
+
 async def test_a_thread_making_long_gil_holding_calls_is_named_top_cause() -> None:
     n = _calibrated_n()
     stop = threading.Event()
@@ -47,15 +56,15 @@ async def test_a_thread_making_long_gil_holding_calls_is_named_top_cause() -> No
         rt.add_node(_control_node(), "priority")
         worker.start()
         try:
-            await wait_until(lambda: _attributed(rt, 8), timeout_sec=30)
+            await wait_until(lambda: _attributed(rt, 12), timeout_sec=30)
         finally:
             stop.set()
             worker.join()
         stats = rt.statistics()
-    top = stats["culprits"][0]
+    top = _top_named(stats["culprits"])
     assert top.function.endswith("crunch_in_thread") and top.thread == "cruncher", [c.describe() for c in stats["culprits"]]
     assert top.where.startswith("test_culprit.py:") and top.node == ""
-    assert stats["late_periods"] >= top.late_periods >= 8 and top.lateness_total_sec > 0.008
+    assert stats["late_periods"] >= top.late_periods >= 6 and top.lateness_total_sec > 0.006
 
 
 async def test_perception_holding_the_gil_inline_on_the_main_loop_is_named_with_its_node() -> None:
@@ -72,9 +81,9 @@ async def test_perception_holding_the_gil_inline_on_the_main_loop_is_named_with_
     async with Runtime(handle_signals=False) as rt:
         rt.add_node(_control_node(), "priority")
         rt.add_node(Perception())
-        await wait_until(lambda: _attributed(rt, 8), timeout_sec=30)
+        await wait_until(lambda: _attributed(rt, 12), timeout_sec=30)
         culprits = rt.statistics()["culprits"]
-    top = culprits[0]
+    top = _top_named(culprits)
     assert top.function.endswith("Perception.perceive"), [c.describe() for c in culprits]
     assert (top.node, top.entity, top.thread) == ("/perception", "timer 0.007s", "main loop")
 
