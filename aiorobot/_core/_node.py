@@ -76,7 +76,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         top`` reads, see docs/observability.md).
     enable_rosout
         As in rclpy: what the node's logger emits is also published on ``/rosout``
-        (``rcl_interfaces/msg/Log``, transient local, depth 1000).
+        (``rcl_interfaces/msg/Log``, transient local, depth 1000); ``--disable-rosout-logs``
+        in ``cli_args`` turns it off too.
 
     rclpy difference: the ``use_sim_time`` parameter, when nothing sets it, follows
     ``Runtime(use_sim_time=...)`` instead of defaulting to false, so one runtime flag
@@ -142,7 +143,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         #: (start ns, end ns, entity) of the node's last finished callback, for the culprit watch
         self._last_callback: tuple[int, int, Any] | None = None
         self._setup_parameters(automatically_declare_parameters_from_overrides, start_parameter_services)
-        if enable_rosout:
+        if enable_rosout and arguments.rosout is not False:  # --disable-rosout-logs in cli_args
             from ..msgs.rcl_interfaces import Log
 
             self._logger._attach_rosout(self.create_publisher(Log, "/rosout", ROSOUT_QOS))

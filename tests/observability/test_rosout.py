@@ -155,3 +155,14 @@ async def test_aiorobot_log_refuses_a_bad_regex_in_one_line() -> None:
         "aiorobot log: error: --regex: expected a Python regular expression, found 'tick(' "
         "(missing ), unterminated subpattern at position 4)\n"
     )
+
+
+def test_disable_rosout_logs_in_cli_args_leaves_the_node_off_rosout() -> None:
+    def topics(node: Node) -> list[str]:
+        return [p.topic_name for p in node.publishers]
+
+    assert topics(Node("quiet", cli_args=["--ros-args", "--disable-rosout-logs"])) == ["/parameter_events"]
+    assert topics(Node("loud", cli_args=["--ros-args", "--disable-rosout-logs", "--enable-rosout-logs"])) == [
+        "/parameter_events", "/rosout",
+    ]
+    assert topics(Node("off", enable_rosout=False, cli_args=["--ros-args", "--enable-rosout-logs"])) == ["/parameter_events"]
