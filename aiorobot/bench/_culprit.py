@@ -5,6 +5,10 @@ A 50 Hz timer on the priority loop runs for ``duration_sec`` (5 s; quick: 0.3 s)
 - with the watch off (``Runtime(late_threshold=None)``) and on (the default 1 ms),
   nothing else running: the process's CPU time over the wall time, as a share of
   one core. The difference is the watch's cost while nothing is late (target <= 1 %).
+- with the watch on beside what observing costs: a node logging 100 lines/s (each
+  published on ``/rosout``, received by a subscriber as ``aiorobot log`` does) and the
+  control node's ``~/get_statistics`` read once a second (as ``aiorobot top`` does): its
+  lateness p99 beside the idle row's.
 - with the watch on beside a thread making GIL-holding C calls of about 4 ms
   (``sum(range(N))``) with 3 ms pauses: the late periods, and the top culprit the
   runtime names (it should be that thread's function, ``hold_the_gil``).
@@ -23,7 +27,12 @@ __all__ = ["run", "table"]
 
 PERIOD_SEC = 0.02
 HOLD_SEC = 0.004
-CASES = ("watch off, idle process", "watch on, idle process", "watch on, a thread holding the GIL")
+CASES = (
+    "watch off, idle process",
+    "watch on, idle process",
+    "watch on, /rosout 100 lines/s, statistics read 1/s",
+    "watch on, a thread holding the GIL",
+)
 
 
 def _calibrated_n() -> int:
@@ -31,6 +40,30 @@ def _calibrated_n() -> int:
     start = time.perf_counter()
     sum(range(n))
     return max(10_000, int(n * HOLD_SEC / max(time.perf_counter() - start, 1e-6)))
+
+
+def _observe(rt: Any) -> None:
+    """A node logging 100 lines/s onto /rosout with a subscriber, and a reader of ~/get_statistics."""
+    import logging
+
+    from aiorobot import Node
+    from aiorobot._core._logging import ROSOUT_QOS
+    from aiorobot.msgs.rcl_interfaces import Log
+    from aiorobot.msgs.std_srvs import Trigger
+
+    talker = rt.add_node(Node("chatty"))
+    quiet = logging.getLogger("aiorobot.node.chatty")
+    quiet.propagate = False  # its lines reach /rosout, not the bench's terminal
+    talker.get_logger().set_level("info")
+    talker.create_timer(0.01, lambda: talker.get_logger().info("line"))
+    reader = rt.add_node(Node("observer", start_parameter_services=False))
+    reader.create_subscription(Log, "/rosout", lambda m: None, ROSOUT_QOS)
+    client = reader.create_client(Trigger, "/control/get_statistics")
+
+    async def read() -> None:
+        await client.call(Trigger.Request(), timeout_sec=5.0)
+
+    reader.create_timer(1.0, read)
 
 
 async def _measure(case: str, duration_sec: float) -> dict[str, Any]:
@@ -48,6 +81,8 @@ async def _measure(case: str, duration_sec: float) -> dict[str, Any]:
     control.create_timer(PERIOD_SEC, lambda: None)
     async with Runtime(handle_signals=False, late_threshold=None if case.startswith("watch off") else 0.001) as rt:
         rt.add_node(control, "priority")
+        if "/rosout" in case:
+            _observe(rt)
         await asyncio.sleep(0.1)  # warm-up: the loop and the watch started
         worker = threading.Thread(target=hold_the_gil, name="gil-holder")
         if case.endswith("holding the GIL"):
