@@ -11,19 +11,44 @@ put on the ``aiorobot`` logger. It steps aside as soon as the application
 configures logging itself (``logging.basicConfig(...)``, :func:`setup_logging`,
 a handler of its own); ``logging.getLogger("aiorobot").setLevel("WARNING")``
 quietens it, ``node.get_logger().set_level("debug")`` shows more of one node.
+
+``/rosout``: as in ROS 2, every node (unless made with ``enable_rosout=False``)
+publishes what its logger emits as ``rcl_interfaces/msg/Log`` on ``/rosout``
+with rclpy's ``qos_profile_rosout_default`` (reliable, transient local, keep
+last 1000, lifespan 10 s), so ``aiorobot log``, a bag recorder and Foxglove's
+Log panel see every process's lines, and a late joiner gets the recent ones.
+The ``name`` field is rcl's logger name (``/robot/talker`` logs as ``robot.talker``).
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import sys
+import threading
 import time
 from typing import TYPE_CHECKING, Any
 
+from ._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from ._time import Duration
+
 if TYPE_CHECKING:
     from ._clock import Clock
+    from ._pubsub import Publisher
 
-__all__ = ["LEVELS", "NodeFormatter", "NodeLogger", "parse_level", "setup_logging"]
+__all__ = ["LEVELS", "ROSOUT_QOS", "NodeFormatter", "NodeLogger", "parse_level", "setup_logging"]
+
+#: rclpy's ``qos_profile_rosout_default`` (rcl's ``rmw_qos_profile_rosout_default``)
+ROSOUT_QOS = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1000,
+    lifespan=Duration(seconds=10),
+)
+
+#: set while a thread publishes a /rosout line: what that publish logs is not published again
+_in_rosout = threading.local()
 
 LEVELS = {
     "debug": logging.DEBUG,
@@ -92,6 +117,13 @@ class NodeLogger:
         self._clock = clock
         self._last_emit: dict[tuple[str, int], float] = {}
         self._once: set[tuple[str, int]] = set()
+        self._rosout: Publisher[Any] | None = None
+        #: rcl's logger name: ``/robot/talker`` -> ``robot.talker``
+        self.rosout_name = dotted if dotted != "root" else ""
+
+    def _attach_rosout(self, publisher: Publisher[Any] | None) -> None:
+        """Publish every emitted record on ``publisher`` (the node's ``/rosout``), children too."""
+        self._rosout = publisher
 
     def _bind_clock(self, clock: Clock) -> None:
         self._clock = clock
@@ -110,6 +142,7 @@ class NodeLogger:
 
     def get_child(self, suffix: str) -> NodeLogger:
         child = NodeLogger(f"{self.name}.{suffix}", self._clock)
+        child._rosout = self._rosout
         return child
 
     def log(
@@ -153,7 +186,43 @@ class NodeLogger:
             extra={"node": self.name, "ros_time_ns": stamp},
             stacklevel=stacklevel + 1,
         )
+        if self._rosout is not None:
+            self._publish_rosout(level, msg, args, stamp, stacklevel + 1, exc_info)
         return True
+
+    def _publish_rosout(
+        self, level: int, msg: str, args: tuple[Any, ...], stamp: int, stacklevel: int, exc_info: Any
+    ) -> None:
+        """One ``rcl_interfaces/msg/Log`` on ``/rosout``; a failure here is never the caller's."""
+        pub = self._rosout
+        if pub is None or pub.destroyed or getattr(_in_rosout, "active", False):
+            return
+        _in_rosout.active = True
+        try:
+            from ..msgs.builtin_interfaces import Time as TimeMsg
+            from ..msgs.rcl_interfaces import Log
+
+            text = str(msg) % args if args else str(msg)
+            if exc_info:
+                text += "\n" + _format_exc(exc_info)
+            caller = sys._getframe(stacklevel)
+            sec, nanosec = divmod(max(int(stamp), 0), 1_000_000_000)
+            pub.publish(
+                Log(
+                    stamp=TimeMsg(sec=sec, nanosec=nanosec),
+                    # the logging levels are rcl's numbers (DEBUG 10 ... FATAL 50); others round down
+                    level=min(max(level // 10 * 10, Log.DEBUG), Log.FATAL),
+                    name=self.rosout_name,
+                    msg=text,
+                    file=os.path.basename(caller.f_code.co_filename),
+                    function=caller.f_code.co_name,
+                    line=caller.f_lineno,
+                )
+            )
+        except Exception:  # a closed runtime, a bad format string: the record went to logging already
+            pass
+        finally:
+            _in_rosout.active = False
 
     def debug(self, msg: str, *args: Any, **kw: Any) -> bool:
         return self.log(logging.DEBUG, msg, *args, stacklevel=2, **kw)
@@ -174,6 +243,18 @@ class NodeLogger:
 
     def exception(self, msg: str, *args: Any, **kw: Any) -> bool:
         return self.log(logging.ERROR, msg, *args, exc_info=True, stacklevel=2, **kw)
+
+
+def _format_exc(exc_info: Any) -> str:
+    import traceback
+
+    if exc_info is True:
+        exc_info = sys.exc_info()
+    elif isinstance(exc_info, BaseException):
+        exc_info = (type(exc_info), exc_info, exc_info.__traceback__)
+    if not isinstance(exc_info, tuple) or exc_info[0] is None:
+        return ""
+    return "".join(traceback.format_exception(*exc_info)).rstrip()
 
 
 class NodeFormatter(logging.Formatter):

@@ -14,6 +14,7 @@ import asyncio
 import functools
 import inspect
 import threading
+import time
 from collections.abc import Awaitable, Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -21,7 +22,7 @@ from ._actions import DEFAULT_RESULT_TIMEOUT_SEC, ActionClient, ActionServer
 from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 from ._handoff import post
-from ._logging import NodeLogger
+from ._logging import ROSOUT_QOS, NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
 from ._node_graph import NodeGraphMixin
 from ._node_parameters import NodeParametersMixin
@@ -30,11 +31,13 @@ from ._event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from ._pubsub import MessageStream, Publisher, Subscription
 from ._qos import QoSProfile, to_qos_profile
 from ._services import Client, Service
+from ._stats import CallbackRecorder, create_statistics_service
 from ._time import Time
 from ._timer import Rate, Timer
 from ._waker import LoopWaker, TimerFdWaker
 
 if TYPE_CHECKING:
+    from ._culprit import LateWatch
     from ._runtime import Runtime
 
 __all__ = ["Node"]
@@ -69,10 +72,17 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         As in rclpy: setting undeclared parameters declares them (dynamically typed);
         every override is declared at construction; the ``~/get_parameters`` family of
         services is created. ``/parameter_events`` is always published.
+        With the parameter services comes ``~/get_statistics`` (aiorobot's: what ``aiorobot
+        top`` reads, see docs/observability.md).
+    enable_rosout
+        As in rclpy: what the node's logger emits is also published on ``/rosout``
+        (``rcl_interfaces/msg/Log``, transient local, depth 1000); ``--disable-rosout-logs``
+        in ``cli_args`` turns it off too.
 
     rclpy difference: the ``use_sim_time`` parameter, when nothing sets it, follows
     ``Runtime(use_sim_time=...)`` instead of defaulting to false, so one runtime flag
-    switches every node; ``parameter_overrides`` also takes a ``{name: value}`` mapping.
+    switches every node; ``parameter_overrides`` also takes a ``{name: value}`` mapping; a node
+    with parameter services also serves ``~/get_statistics`` (what ``aiorobot top`` reads).
     """
 
     def __init__(
@@ -86,6 +96,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         automatically_declare_parameters_from_overrides: bool = False,
         start_parameter_services: bool = True,
         cli_args: Sequence[str] | None = None,
+        enable_rosout: bool = True,
     ) -> None:
         from ._node_arguments import resolve_node_arguments
 
@@ -124,8 +135,20 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._thread_id: int | None = None
         self._waker: LoopWaker | TimerFdWaker | None = None
         self._clock: Clock = Clock()
+        #: the runtime's culprit watch, for a node on the priority loop (see ``_culprit``)
+        self._late_watch: LateWatch | None = None
         self._started = False
+        #: callback statistics per entity (see ``_stats``), filled by ``_invoke``
+        self._callback_stats: dict[Any, CallbackRecorder] = {}
+        #: (start ns, end ns, entity) of the node's last finished callback, for the culprit watch
+        self._last_callback: tuple[int, int, Any] | None = None
         self._setup_parameters(automatically_declare_parameters_from_overrides, start_parameter_services)
+        if enable_rosout and arguments.rosout is not False:  # --disable-rosout-logs in cli_args
+            from ..msgs.rcl_interfaces import Log
+
+            self._logger._attach_rosout(self.create_publisher(Log, "/rosout", ROSOUT_QOS))
+        if start_parameter_services:
+            create_statistics_service(self)
 
     def __repr__(self) -> str:
         where = f" on {self._executor}" if self._executor else " (not added)"
@@ -333,10 +356,11 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             return True
         return False
 
-    @staticmethod
-    def _close_timer(timer: Timer) -> None:
+    def _close_timer(self, timer: Timer) -> None:
         if timer._task is not None:
             timer._task.cancel()
+        if self._late_watch is not None:
+            self._late_watch.disarm(id(timer))
 
     def create_service(
         self,
@@ -538,6 +562,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._thread_id = thread_id
         self._waker = waker
         self._clock = self._time_source.clock_for(runtime)
+        self._late_watch = runtime.late_watch if executor == "priority" else None
         self._logger._bind_clock(self._clock)
         for timer in self._timers:
             if not timer._cancelled:
@@ -549,6 +574,7 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         self._loop = None
         self._thread_id = None
         self._waker = None
+        self._late_watch = None
         self._started = False
 
     def _call_soon(self, fn: Callable[..., Any], *args: Any) -> None:
@@ -689,6 +715,28 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             if not work.done():
                 work.cancel()
 
+    def _record_callback(self, entity: Any, start_ns: int) -> None:
+        """Count one callback of ``entity`` that started at ``start_ns`` (``time.monotonic_ns``)."""
+        end = time.monotonic_ns()
+        recorder = self._callback_stats.get(entity)
+        if recorder is None:
+            recorder = self._callback_stats[entity] = CallbackRecorder()
+        recorder.add(end - start_ns)
+        self._last_callback = (start_ns, end, entity)
+
+    async def _timed_call(self, entity: Any, fn: Callable[..., Any], args: tuple[Any, ...], start_deadline: int | None) -> Any:
+        """``fn(*args)``, awaited if it returns an awaitable, its duration counted against ``entity``."""
+        if start_deadline is not None:
+            entity._record_start(start_deadline)
+        start = time.monotonic_ns()
+        try:
+            result = fn(*args)
+            if result is not None and inspect.isawaitable(result):
+                return await result
+            return result
+        finally:
+            self._record_callback(entity, start)
+
     async def _invoke(
         self,
         entity: Any,
@@ -701,18 +749,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         try:
             if group.exclusive:
                 async with group:
-                    if start_deadline is not None:
-                        entity._record_start(start_deadline)
-                    result = fn(*args)
-                    if result is not None and inspect.isawaitable(result):
-                        return await result
-                    return result
-            if start_deadline is not None:
-                entity._record_start(start_deadline)
-            result = fn(*args)
-            if result is not None and inspect.isawaitable(result):
-                return await result
-            return result
+                    return await self._timed_call(entity, fn, args, start_deadline)
+            return await self._timed_call(entity, fn, args, start_deadline)
         except asyncio.CancelledError:
             raise
         except Exception as err:

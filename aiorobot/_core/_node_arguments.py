@@ -23,6 +23,8 @@ class NodeArguments:
     log_level: str | None = None
     #: where each file or ``-p`` value came from, for errors: ``"f.yaml: node.ros__parameters.x (line 3)"``
     sources: dict[str, str] = field(default_factory=dict)
+    #: ``--enable-rosout-logs`` / ``--disable-rosout-logs``; None when neither is given
+    rosout: bool | None = None
 
 
 def resolve_node_arguments(
@@ -54,7 +56,7 @@ def resolve_node_arguments(
     for overridden in overrides:
         sources.pop(overridden, None)
     level = args.log_levels.get(final_name, args.log_levels.get(fqn, args.log_level))  # --log-level name:=level
-    return NodeArguments(merged, remaps, quiet, level, sources)
+    return NodeArguments(merged, remaps, quiet, level, sources, args.rosout)
 
 
 def _cli_overrides(args: Any, fqn: str) -> tuple[dict[str, Any], dict[str, str]]:

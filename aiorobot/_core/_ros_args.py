@@ -8,7 +8,8 @@ such sections); the rest are the program's own arguments. Understood:
 - ``-r``/``--remap [node:]from:=to``, including ``__node:=name`` and ``__ns:=/ns``,
 - ``--params-file FILE``,
 - ``--log-level [logger:=]LEVEL``,
-- ``--enclave``/``-e VALUE``, ``--enable-rosout-logs`` and the like (accepted, no effect here).
+- ``--enable-rosout-logs`` / ``--disable-rosout-logs`` (the nodes' ``/rosout``, as rcl),
+- ``--enclave``/``-e VALUE``, ``--disable-stdout-logs`` and the like (accepted, no effect here).
 
 A ``node:`` prefix makes a rule apply only to the node of that name. ``-p`` values and
 ``--params-file`` sections apply in command-line order, as rcl reads them into one table
@@ -57,6 +58,8 @@ class RosArgs:
     params_files: list[str] = field(default_factory=list)
     log_levels: dict[str, str] = field(default_factory=dict)  # "" = the default level
     unparsed: list[str] = field(default_factory=list)
+    #: ``--enable-rosout-logs`` (True) / ``--disable-rosout-logs`` (False), the last one given
+    rosout: bool | None = None
     #: ``-p`` rules and ``--params-file`` paths in command-line order
     overrides_in_order: list[Rule | str] = field(default_factory=list)
 
@@ -100,6 +103,8 @@ def parse_ros_args(argv: Sequence[str]) -> RosArgs:
             i += 1
             continue
         if arg in _FLAGS_WITHOUT_VALUE:
+            if arg.endswith("-rosout-logs"):
+                result.rosout = arg == "--enable-rosout-logs"
             i += 1
             continue
         if arg not in ("-p", "--param", "-r", "--remap", "--params-file", "--log-level", *_FLAGS_WITH_VALUE):

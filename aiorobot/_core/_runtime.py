@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from ._bus import Bus, Incompatibility
 from ._errors import QoSIncompatibleError
 from ._clock import Clock
+from ._culprit import LateWatch
 from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
 from ._node import Node
 from ._priority import PriorityLoop
@@ -45,6 +46,8 @@ FLUSH_TIMEOUT_SEC = 1.0
 #: How long a callback may hold a loop before the watchdog reports a stall.
 STALL_THRESHOLD_SEC = 0.5
 PRIORITY_STALL_THRESHOLD_SEC = 0.05
+#: A priority-loop timer this late is a late period, whose culprit is looked for (``_culprit``).
+LATE_THRESHOLD_SEC = 0.001
 
 #: What ``Runtime(config=...)`` calls with its ``config``: returns the keyword arguments of
 #: :class:`Runtime` that the file sets, and the builder of its nodes (``[(node, executor), ...]``,
@@ -99,6 +102,12 @@ class Runtime:
     stall_threshold, priority_stall_threshold
         Seconds a callback may hold the main / priority loop before the watchdog reports
         the stall (once per callback, with its stack) and counts it in :meth:`statistics`.
+    late_threshold
+        Seconds after its deadline a priority-loop timer's callback may start before the
+        period counts as late; the runtime then records what held the loop (a callback on
+        it, or the function that held the GIL in another thread), reported by
+        :meth:`statistics` (``"culprits"``), ``aiorobot top`` and the run summary. ``None``
+        turns this watch off.
     """
 
     def __init__(
@@ -117,6 +126,7 @@ class Runtime:
         shutdown_timeout: float = SHUTDOWN_TIMEOUT_SEC,
         stall_threshold: float = STALL_THRESHOLD_SEC,
         priority_stall_threshold: float = PRIORITY_STALL_THRESHOLD_SEC,
+        late_threshold: float | None = LATE_THRESHOLD_SEC,
     ) -> None:
         #: builds the config file's nodes on entry (``config=``)
         self._config_nodes: Callable[[], list[tuple[Node, str]]] | None = None
@@ -140,11 +150,15 @@ class Runtime:
             ("shutdown_timeout", shutdown_timeout),
             ("stall_threshold", stall_threshold),
             ("priority_stall_threshold", priority_stall_threshold),
+            ("late_threshold", LATE_THRESHOLD_SEC if late_threshold is None else late_threshold),
         ):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
                 raise ValueError(f"{name}: expected a number of seconds > 0, found {value!r}")
         self.shutdown_timeout = float(shutdown_timeout)
         self._stall_thresholds = {"main": float(stall_threshold), "priority": float(priority_stall_threshold)}
+        #: None: late periods are not watched (no sampling thread)
+        self.late_threshold = None if late_threshold is None else float(late_threshold)
+        self._late_watch: LateWatch | None = None
         self._watchdog = Watchdog()
         self._saved_handlers: dict[int, Any] = {}
         #: what the shutdown had to leave running (a blocked loop thread), one line each
@@ -364,11 +378,34 @@ class Runtime:
             self._watchdog.watch("priority", prio.loop, prio.thread_id, self._stall_thresholds["priority"])
             self._saved_switch_interval = sys.getswitchinterval()
             sys.setswitchinterval(min(self._saved_switch_interval, PRIORITY_SWITCH_INTERVAL_SEC))
+            if self.late_threshold is not None:
+                loops = {self._thread_id: "main"} if self._thread_id is not None else {}
+                self._late_watch = LateWatch(
+                    self.late_threshold, prio.thread_id, loops=loops, recent=self._recent_callback
+                )
         return self._priority
 
     @property
     def priority_loop(self) -> PriorityLoop | None:
         return self._priority
+
+    def _recent_callback(self, executor: str, since_ns: int) -> tuple[Node, Any, int] | None:
+        """The node callback on ``executor``'s loop that ran longest since ``since_ns``: (node, entity, ns)."""
+        best: tuple[Node, Any, int] | None = None
+        now = time.monotonic_ns()
+        for node in list(self._nodes):
+            last = node._last_callback
+            if last is None or node._executor != executor:
+                continue
+            ran = min(last[1], now) - max(last[0], since_ns)
+            if ran > 0 and (best is None or ran > best[2]):
+                best = (node, last[2], ran)
+        return best
+
+    @property
+    def late_watch(self) -> LateWatch | None:
+        """What finds the culprits of late priority periods; None until a node runs on that loop."""
+        return self._late_watch
 
     # -- running ------------------------------------------------------------------------
 
@@ -445,15 +482,19 @@ class Runtime:
             self.shutdown()
 
     def statistics(self) -> dict[str, Any]:
-        """Counts of what went wrong: stalls, callback failures and failed starts.
+        """Counts of what went wrong: stalls, callback failures, failed starts, late periods.
 
         ``{"stalls": {(loop, node, entity): n}, "failures": {(node, entity): n},
-        "failed_starts": [node, ...]}``.
+        "failed_starts": [node, ...], "late_periods": n, "culprits": [Culprit, ...]}``; the
+        culprits of late priority periods come most lateness first (see ``late_threshold``).
         """
+        watch = self._late_watch
         return {
             "stalls": dict(self._watchdog.stalls),
             "failures": dict(self._failures),
             "failed_starts": list(self._failed_starts),
+            "late_periods": watch.late_periods if watch is not None else 0,
+            "culprits": watch.culprits() if watch is not None else [],
         }
 
     async def settle(self, *, rounds: int = 3, max_rounds: int = 1000) -> None:
@@ -555,6 +596,8 @@ class Runtime:
                 self.abandoned.extend(what)
                 _log.error(f"the priority loop did not stop within shutdown_timeout; abandoned: {'; '.join(what)}")
             self._priority = None
+            if self._late_watch is not None:
+                self._late_watch.close()  # its figures stay readable through statistics()
             if self._saved_switch_interval is not None:
                 sys.setswitchinterval(self._saved_switch_interval)
         await self.transport.close()

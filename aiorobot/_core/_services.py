@@ -13,6 +13,7 @@ import asyncio
 import contextvars
 import inspect
 import threading
+import time
 import uuid
 from collections import deque
 from collections.abc import Callable
@@ -227,12 +228,16 @@ class Service(_ServiceEndpoint):
         token = _CURRENT_CALL.set(call)
         try:
             async with self.callback_group:
-                if self._with_response:
-                    response = self.handler(call.request, self.srv_type.Response())
-                else:
-                    response = self.handler(call.request)
-                if inspect.isawaitable(response):
-                    response = await response
+                start = time.monotonic_ns()
+                try:
+                    if self._with_response:
+                        response = self.handler(call.request, self.srv_type.Response())
+                    else:
+                        response = self.handler(call.request)
+                    if inspect.isawaitable(response):
+                        response = await response
+                finally:
+                    self.node._record_callback(self, start)
         except asyncio.CancelledError:
             _reply(call, exc=ServiceError(f"service {self.srv_name} was shut down while handling the call"))
             raise

@@ -144,6 +144,8 @@ class Timer:
         self._max_late = 0
         self._next_ns: int | None = None
         self._restart = False
+        #: how the watchdog and the culprit watch name this timer's callbacks
+        self._entity_name = f"timer {self.period_ns / 1e9:g}s"
         self._wake: asyncio.Future[None] | None = None
         self.destroyed = False
 
@@ -161,6 +163,7 @@ class Timer:
         if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
             raise ValueError(f"timer_period_ns: expected an int > 0 (nanoseconds), got {value!r}")
         self.period_ns = value
+        self._entity_name = f"timer {value / 1e9:g}s"
         if not self._cancelled:
             self.reset()
 
@@ -301,6 +304,9 @@ class Timer:
             self._restart = False
             deadline = self._next_ns
             assert deadline is not None
+            watch = node._late_watch
+            if watch is not None and not node._clock.use_sim_time:
+                watch.arm(id(self), deadline, self._entity_name)
             try:
                 await self._sleep_until(deadline)
             except ClockJump:
@@ -343,6 +349,9 @@ class Timer:
         self._lateness.append(late)
         if late > self._max_late:
             self._max_late = late
+        watch = self.node._late_watch
+        if watch is not None:
+            watch.fired(id(self), deadline_ns, late)
 
     def destroy(self) -> None:
         self.node.destroy_timer(self)

@@ -16,7 +16,7 @@ import asyncio
 import time
 from typing import Any
 
-from ._noise import NoiseMeter
+from ._noise import measure_cases
 
 __all__ = ["RCLPY_REFERENCE_PCT", "run"]
 
@@ -60,22 +60,7 @@ async def _measure(case: str, duration_sec: float) -> dict[str, Any]:
     return {"case": case, "core_pct": 100.0 * (cpu1 - cpu0) / (wall1 - wall0), "wall_sec": wall1 - wall0}
 
 
-async def _main(duration_sec: float) -> list[dict[str, Any]]:
-    rows = []
-    for case in CASES:
-        with NoiseMeter() as meter:
-            row = await _measure(case, duration_sec)
-        assert meter.result is not None
-        row["noise"] = meter.result.as_dict()
-        rows.append(row)
-    return rows
-
-
 def run(quick: bool = False) -> dict[str, Any]:
     """Measure every case; returns ``{"rows": [...], "reference_pct": 16.0, "noise": {...}}``."""
-    import aiorobot
-
-    with NoiseMeter() as meter:
-        rows = aiorobot.run(_main(0.2 if quick else 5.0))
-    assert meter.result is not None
-    return {"rate_hz": RATE_HZ, "rows": rows, "reference": {"rclpy 100 Hz publisher": RCLPY_REFERENCE_PCT}, "noise": meter.result.as_dict()}
+    rows, noise = measure_cases(_measure, CASES, 0.2 if quick else 5.0)
+    return {"rate_hz": RATE_HZ, "rows": rows, "reference": {"rclpy 100 Hz publisher": RCLPY_REFERENCE_PCT}, "noise": noise}

@@ -13,10 +13,13 @@ are ``None``.
 from __future__ import annotations
 
 import os
+from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
-__all__ = ["CpuTimes", "NoiseMeter", "NoiseSample", "noise_between", "parse_loadavg", "parse_proc_stat"]
+__all__ = [
+    "CpuTimes", "NoiseMeter", "NoiseSample", "measure_cases", "noise_between", "parse_loadavg", "parse_proc_stat",
+]
 
 _FIELDS = ("user", "nice", "system", "idle", "iowait", "irq", "softirq", "steal")
 
@@ -170,3 +173,26 @@ class NoiseMeter:
 
 def cpu_count() -> int:
     return os.cpu_count() or 1
+
+
+def measure_cases(
+    measure: Callable[[str, float], Awaitable[dict[str, Any]]], cases: Sequence[str], duration_sec: float
+) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """``await measure(case, duration_sec)`` for each case in one event loop, each row with its
+    noise beside it (``row["noise"]``); returns the rows and the noise of the whole run."""
+    import aiorobot
+
+    async def each() -> list[dict[str, Any]]:
+        rows = []
+        for case in cases:
+            with NoiseMeter() as meter:
+                row = await measure(case, duration_sec)
+            assert meter.result is not None
+            row["noise"] = meter.result.as_dict()
+            rows.append(row)
+        return rows
+
+    with NoiseMeter() as meter:
+        rows = aiorobot.run(each())
+    assert meter.result is not None
+    return rows, meter.result.as_dict()

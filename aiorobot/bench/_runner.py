@@ -23,6 +23,7 @@ PARTS: dict[str, str] = {
     "timer": "aiorobot.bench._timer",
     "latency": "aiorobot.bench._latency",
     "cpu": "aiorobot.bench._cpu",
+    "culprit": "aiorobot.bench._culprit",
     "tf": "aiorobot.bench.tf",
     "bag": "aiorobot.bench._bag",
     "nav": "aiorobot.bench._nav",

@@ -34,6 +34,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "graph": ("aiorobot.cli._graph_cmd", "the running graph's nodes and topics, as text, Graphviz or an HTML page"),
     "param": ("aiorobot.cli._param_cmd", "parameters of the running graph's nodes: list, get, set, dump, load, describe"),
     "lifecycle": ("aiorobot.cli._lifecycle_cmd", "lifecycle nodes of the running graph: nodes, get, set, list"),
+    "log": ("aiorobot.cli._log", "the graph's /rosout as a live console, every process's lines (level, node, regex filters)"),
+    "top": ("aiorobot.cli._top", "every node of every process live: CPU, callbacks/s, callback time, queues, lateness, culprits"),
     "tf": ("aiorobot.cli._tf_cmd", "transforms of the running graph: echo (tf2_echo), tree (view_frames)"),
     "interface": ("aiorobot.cli._interface_cmd", "message, service and action types: list, packages, package, show"),
     "exec": ("aiorobot.cli._exec", "run an unmodified rclpy program (ROS 2 Python) on aiorobot"),

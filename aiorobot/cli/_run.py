@@ -242,6 +242,13 @@ def _outcome(rt: Runtime) -> int:
         lines.append(f"  {fqn}: {entity} stalled the {loop} loop {count} time{'s' if count != 1 else ''}")
     if lines:
         print("failures:\n" + "\n".join(lines), file=sys.stderr)
+    if stats["late_periods"]:
+        causes = "".join(f"\n  {c.describe()}" for c in stats["culprits"])
+        print(
+            f"late priority periods: {stats['late_periods']} started more than "
+            f"{(rt.late_threshold or 0) * 1000:g} ms after their deadline; top causes:{causes}",
+            file=sys.stderr,
+        )
     if rt.abandoned:
         print("abandoned at shutdown: " + "; ".join(rt.abandoned), file=sys.stderr)
         return EXIT_SHUTDOWN_TIMEOUT

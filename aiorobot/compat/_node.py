@@ -335,6 +335,7 @@ def make_node_class(base: type, name: str, module: str, doc: str) -> type:
         enable_logger_service: bool = False, **extra: Any,
     ) -> None:
         kwargs = dict(
+            enable_rosout=enable_rosout,
             start_parameter_services=start_parameter_services, parameter_overrides=parameter_overrides,
             allow_undeclared_parameters=allow_undeclared_parameters,
             automatically_declare_parameters_from_overrides=automatically_declare_parameters_from_overrides,

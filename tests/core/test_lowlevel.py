@@ -58,14 +58,14 @@ async def test_watch_publishers_reports_existing_then_new_ones_until_unwatched()
         node.create_publisher(String, "/before", 10)
         node.create_subscription(String, "/subscribed_only", lambda m: None, 10)
         unwatch = lowlevel.watch_publishers(rt, lambda pub: seen.append(pub.topic_name))
-        assert seen == ["/before", "/parameter_events"]  # the publishers already there, not subscriptions
+        assert seen == ["/before", "/parameter_events", "/rosout"]  # the publishers already there, not subscriptions
         node.create_publisher(String, "/after", 10)
-        assert seen[2:] == ["/after"]  # reported before create_publisher returned
+        assert seen[3:] == ["/after"]  # reported before create_publisher returned
         unwatch()
         node.create_publisher(String, "/unwatched", 10)
         new_only = lowlevel.watch_publishers(rt, lambda pub: seen.append("new " + pub.topic_name), existing=False)
         new_only()
-    assert seen == ["/before", "/parameter_events", "/after"]
+    assert seen == ["/before", "/parameter_events", "/rosout", "/after"]
 
 
 async def test_create_task_belongs_to_the_node_and_ends_with_it():
@@ -131,7 +131,9 @@ async def test_on_added_runs_before_the_nodes_endpoints_join_and_a_failure_leave
         rt.add_node(Watcher("watcher"))
         rt.add_node(talker)
         # the watcher's own publisher joins after on_added, the talker's after it: all seen
-        assert order == ["added, runtime has 0 topics", "/parameter_events", "/parameter_events", "/chatter"]
+        assert order == [
+            "added, runtime has 0 topics", "/parameter_events", "/rosout", "/parameter_events", "/rosout", "/chatter",
+        ]
         broken = Broken("broken")
         with pytest.raises(OSError, match="^port taken$"):
             rt.add_node(broken)

@@ -112,6 +112,7 @@ def test_publisher_and_subscriber_names_and_types_by_node(node):
     assert node.get_publisher_names_and_types_by_node(TEST_NODE, TEST_NAMESPACE) == [
         ("/my_ns/out", ["std_msgs/msg/String"]),
         ("/parameter_events", ["rcl_interfaces/msg/ParameterEvent"]),  # every node has it, as in rclpy
+        ("/rosout", ["rcl_interfaces/msg/Log"]),  # this one too
     ]
     assert node.get_subscriber_names_and_types_by_node(TEST_NODE, TEST_NAMESPACE) == [
         ("/my_ns/in", ["std_msgs/msg/String"])

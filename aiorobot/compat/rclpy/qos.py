@@ -23,13 +23,14 @@ from ..._core._qos import (
     qos_profile_sensor_data,
     qos_profile_system_default,
 )
+from ..._core._logging import ROSOUT_QOS
 from .._missing import module_getattr
 
 __all__ = [
     "DurabilityPolicy", "HistoryPolicy", "LivelinessPolicy", "QoSDurabilityPolicy", "QoSHistoryPolicy",
     "QoSLivelinessPolicy", "QoSPolicyKind", "QoSPresetProfiles", "QoSProfile", "QoSReliabilityPolicy",
     "ReliabilityPolicy", "qos_policy_name_from_kind", "qos_profile_parameter_events", "qos_profile_parameters",
-    "qos_profile_sensor_data", "qos_profile_services_default", "qos_profile_system_default",
+    "qos_profile_rosout_default", "qos_profile_sensor_data", "qos_profile_services_default", "qos_profile_system_default",
 ]
 
 _FIELDS = tuple(f.name for f in dataclasses.fields(_qos.QoSProfile))
@@ -72,6 +73,7 @@ QoSReliabilityPolicy = ReliabilityPolicy
 qos_profile_services_default = _qos.QoSProfile()
 qos_profile_parameters = _qos.QoSProfile(depth=1000)
 qos_profile_parameter_events = _qos.QoSProfile(depth=1000)
+qos_profile_rosout_default = ROSOUT_QOS  # what every node's /rosout publisher uses
 
 __getattr__ = module_getattr(
     __name__, "rclpy.qos",
