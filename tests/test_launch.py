@@ -70,8 +70,19 @@ def test_a_file_without_a_runtime_table_gets_the_runtimes_own_defaults(tmp_path)
     defaults = {n: p.default for n, p in inspect.signature(aiorobot.Runtime).parameters.items()}
     assert options == {name: defaults[name] for name in options}
     fields = RuntimeConfig()
-    for name in ("domain_id", "shutdown_timeout", "stall_threshold", "priority_stall_threshold"):
+    for name in ("domain_id", "shutdown_timeout", "stall_threshold", "priority_stall_threshold", "late_threshold"):
         assert getattr(fields, name) == defaults[name], name
+
+
+def test_late_threshold_is_set_in_the_file_or_turned_off_with_false(tmp_path):
+    from aiorobot.launch import ConfigError
+
+    for text, expected in (("late_threshold = 0.005", 0.005), ("late_threshold = false", None)):
+        path = write(tmp_path, GRAPH.replace("domain_id = 7\n", f"domain_id = 7\n{text}\n"))
+        assert runtime_options(load_config(path))["late_threshold"] == expected
+    path = write(tmp_path, GRAPH.replace("domain_id = 7\n", "domain_id = 7\nlate_threshold = 0\n"))
+    with pytest.raises(ConfigError, match=r"runtime\.late_threshold: expected a number of seconds > 0 or false, found 0$"):
+        load_config(path)
 
 
 def test_the_core_and_the_transports_import_no_launch_module_and_runtime_says_what_to_call_instead():

@@ -146,6 +146,7 @@ class Runtime:
             shutdown_timeout = settings["shutdown_timeout"]
             stall_threshold = settings["stall_threshold"]
             priority_stall_threshold = settings["priority_stall_threshold"]
+            late_threshold = settings["late_threshold"]
         for name, value in (
             ("shutdown_timeout", shutdown_timeout),
             ("stall_threshold", stall_threshold),

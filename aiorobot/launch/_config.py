@@ -26,7 +26,13 @@ from typing import Any
 
 from .._core._errors import ConfigError, InvalidNameError
 from .._core._names import expand_name, validate_namespace, validate_node_name
-from .._core._runtime import EXECUTORS, PRIORITY_STALL_THRESHOLD_SEC, SHUTDOWN_TIMEOUT_SEC, STALL_THRESHOLD_SEC
+from .._core._runtime import (
+    EXECUTORS,
+    LATE_THRESHOLD_SEC,
+    PRIORITY_STALL_THRESHOLD_SEC,
+    SHUTDOWN_TIMEOUT_SEC,
+    STALL_THRESHOLD_SEC,
+)
 from .._core._transport import MAX_DOMAIN_ID, transport_names
 
 __all__ = [
@@ -63,6 +69,7 @@ _RUNTIME_KEYS = (
     "shutdown_timeout",
     "stall_threshold",
     "priority_stall_threshold",
+    "late_threshold",
 )
 _NODE_KEYS = (
     "name", "use", "executor", "namespace", "parameters", "remap", "log_level", "parameters_file", "on_failure", "process"
@@ -105,6 +112,7 @@ class RuntimeConfig:
     shutdown_timeout: float = SHUTDOWN_TIMEOUT_SEC
     stall_threshold: float = STALL_THRESHOLD_SEC
     priority_stall_threshold: float = PRIORITY_STALL_THRESHOLD_SEC
+    late_threshold: float | None = LATE_THRESHOLD_SEC  # None (``false`` in the file): no culprit watch
 
 
 @dataclass(frozen=True, slots=True)
@@ -370,6 +378,12 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
         if isinstance(value, bool) or not value > 0:
             raise checker.error(f"runtime.{name}", f"expected a number of seconds > 0, found {value!r}")
         seconds[name] = float(value)
+    late = table.get("late_threshold", LATE_THRESHOLD_SEC)
+    if late is not False:
+        checker.check_type(late, "runtime.late_threshold", (int, float), "a number of seconds > 0, or false (no watch)")
+        if isinstance(late, bool) or not late > 0:
+            raise checker.error("runtime.late_threshold", f"expected a number of seconds > 0 or false, found {late!r}")
+    seconds["late_threshold"] = None if late is False else float(late)
     return RuntimeConfig(
         transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file, zenoh_config,
         **seconds

@@ -27,7 +27,7 @@ __all__ = ["config_loader", "open_runtime", "runtime_options"]
 #: the arguments of Runtime that a graph file's [runtime] table sets (the keys of runtime_options)
 _FILE_SETS = (
     "transport", "domain_id", "use_sim_time", "strict_qos", "priority_realtime", "debug_messages",
-    "shutdown_timeout", "stall_threshold", "priority_stall_threshold",
+    "shutdown_timeout", "stall_threshold", "priority_stall_threshold", "late_threshold",
 )
 
 
@@ -47,6 +47,7 @@ def runtime_options(config: GraphConfig) -> dict[str, Any]:
         "shutdown_timeout": rc.shutdown_timeout,
         "stall_threshold": rc.stall_threshold,
         "priority_stall_threshold": rc.priority_stall_threshold,
+        "late_threshold": rc.late_threshold,
     }
 
 
