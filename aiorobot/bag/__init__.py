@@ -3,26 +3,38 @@
 - :class:`Recorder` — a node that records topics of the running graph, losing nothing;
 - :class:`Player` — a node that plays a bag back, paced, optionally publishing ``/clock``;
 - :class:`BagWriter` / :class:`BagReader` — the files themselves (rosbags reads what we write);
-- :func:`reindex` — rebuilds a bag whose recorder was killed (``aiorobot bag reindex``).
+- :func:`reindex` — rebuilds a bag whose recorder was killed (``aiorobot bag reindex``);
+- :func:`check_bag` — replays a bag's inputs into nodes in lock-step on sim time and compares
+  their outputs with the recording, field by field (``aiorobot bag check``, the ``bag_replay`` fixture).
 """
 
 from __future__ import annotations
 
+from ._check import CheckResult, check_bag
+from ._diff import DiffReport, FieldDifference, TopicDiff, parse_tolerance
 from ._metadata import BagError, TopicInfo
 from ._player import Player, PlayerStatistics
 from ._reader import BagReader
 from ._recorder import Recorder, RecorderStatistics
 from ._reindex import reindex
+from ._replay import ReplayResult
 from ._writer import BagWriter
 
 __all__ = [
     "BagError",
     "BagReader",
     "BagWriter",
+    "CheckResult",
+    "DiffReport",
+    "FieldDifference",
     "Player",
     "PlayerStatistics",
     "Recorder",
     "RecorderStatistics",
+    "ReplayResult",
+    "TopicDiff",
     "TopicInfo",
+    "check_bag",
+    "parse_tolerance",
     "reindex",
 ]

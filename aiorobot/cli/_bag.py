@@ -1,8 +1,8 @@
-"""``aiorobot bag record|play|info|reindex``: ``ros2 bag`` for aiorobot graphs.
+"""``aiorobot bag record|play|info|reindex|check``: ``ros2 bag`` for aiorobot graphs.
 
 ``record`` and ``play`` join the running graph through a transport (``--transport``, zenoh by
 default: other processes are only reachable over the network); ``info`` and ``reindex`` work
-on the directory alone.
+on the directory alone; ``check`` (``_bag_check``) replays a bag into nodes in this process.
 """
 
 from __future__ import annotations
@@ -77,6 +77,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                            description="Rebuild the MCAP files and metadata.yaml of a bag whose recorder died (SIGKILL, power loss).")
     reidx.add_argument("bag", type=Path, metavar="DIR")
 
+    from ._bag_check import add_check_arguments
+
+    add_check_arguments(sub)
+
 
 def _transport_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--transport", default="zenoh", choices=("zenoh", "local"),
@@ -89,8 +93,12 @@ def main(args: argparse.Namespace) -> int:
 
     verb = args.bag_command
     if verb is None:
-        print("aiorobot bag: error: expected a verb (record, play, info, reindex)", file=sys.stderr)
+        print("aiorobot bag: error: expected a verb (record, play, info, reindex, check)", file=sys.stderr)
         return 2
+    if verb == "check":
+        from ._bag_check import check_main
+
+        return check_main(args)
     try:
         if verb == "info":
             return _info(args.bag)
