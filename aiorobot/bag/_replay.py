@@ -56,7 +56,7 @@ async def replay(
     outputs: Sequence[str] | None = None,
     settle_rounds: int = 3,
 ) -> ReplayResult:
-    """Build the nodes (each factory called inside the runtime), feed them the bag, capture their outputs.
+    """Build the nodes (each factory called once), feed them the bag, capture their outputs.
 
     ``outputs``: the topics to capture (default: every topic the nodes publish that the bag
     holds). Raises :class:`BagError` when the nodes subscribe to nothing the bag holds, or an
@@ -68,13 +68,15 @@ async def replay(
 
     with BagReader(path) as reader:
         known = {t.name: t for t in reader.topics}
+        # built before the runtime: a node's imports and kernel loading do not stall its loop
+        built = [factory() for factory in factories]
         async with Runtime(use_sim_time=True, transport="local", handle_signals=False) as rt:
             clock = ClockPublisher(name="bag_check_clock")
             rt.add_node(clock)
             now_ns = reader.start_ns
             clock.publish_time(now_ns)  # before the nodes: their timers start where the recording starts
             await rt.settle()
-            nodes = [rt.add_node(factory()) for factory in factories]
+            nodes = [rt.add_node(node) for node in built]
             await rt.settle()
             published = {p.topic_name: p for n in nodes for p in n.publishers}
             subscribed = {s.topic_name for n in nodes for s in n.subscriptions}
