@@ -29,6 +29,7 @@ from ._writer import CHUNK_SIZE, BagWriter
 __all__ = ["Recorder", "RecorderStatistics", "default_bag_name"]
 
 _STOP = object()
+_SPLIT = object()
 #: How long the writer thread lets messages gather between batches.
 _BATCH_SEC = 0.005
 
@@ -58,6 +59,9 @@ class Recorder(Node):
     ``max_bag_duration`` (seconds per file, 0 = no split), ``max_cache_size`` (bytes of messages
     held before a chunk goes to the file: what a crash can lose; default 256 KiB), ``compression``
     (``none`` as rosbag2's default, ``zstd`` or ``lz4`` per chunk).
+
+    rosbag2's recorder services (``~/pause``, ``~/resume``, ``~/is_paused``, ``~/split_bagfile``)
+    call :meth:`pause`, :meth:`resume`, :meth:`is_paused` and :meth:`split_bagfile`.
     """
 
     def __init__(
@@ -102,6 +106,10 @@ class Recorder(Node):
         self._error: BaseException | None = None
         self._bytes = 0
         self._count = 0
+        self._paused = False
+        from ._control import create_recorder_services
+
+        create_recorder_services(self)
 
     def __repr__(self) -> str:
         return f"<Recorder {self.path} topics={len(self._taps)} messages={self._count}>"
@@ -159,6 +167,22 @@ class Recorder(Node):
         if self._error is not None:
             raise BagError(f"recorder {self.get_name()}: writing {self.path} failed: {self._error}")
 
+    # -- control (rosbag2's Recorder API; ``_control`` serves it as rosbag2_interfaces services) ----
+
+    def pause(self) -> None:
+        """Stop writing messages (they are dropped) until :meth:`resume`; the topics stay tapped."""
+        self._paused = True
+
+    def resume(self) -> None:
+        self._paused = False
+
+    def is_paused(self) -> bool:
+        return self._paused
+
+    def split_bagfile(self) -> None:
+        """Go on in a new storage file, after every message received so far."""
+        self._queue.put(_SPLIT)
+
     # -- taps -------------------------------------------------------------------------
 
     def _on_endpoint(self, endpoint: Endpoint) -> None:
@@ -202,7 +226,8 @@ class Recorder(Node):
             put = self._queue.put
 
             def record(msg: Any) -> None:
-                put((name, clock.now().nanoseconds, serialize(msg)))
+                if not self._paused:
+                    put((name, clock.now().nanoseconds, serialize(msg)))
 
             tap = Tap(msg_type, name, qos, record, owner=self.get_fully_qualified_name())
             tap.node, tap.wants_remote = self, True  # also receives remote publishers over a transport
@@ -225,7 +250,9 @@ class Recorder(Node):
                 while True:
                     if item is _STOP:
                         return
-                    if item[0] == "topic":
+                    if item is _SPLIT:
+                        writer.split()
+                    elif item[0] == "topic":
                         _, name, type_name, qos = item
                         writer.add_topic(name, type_name, qos)
                     else:

@@ -115,6 +115,12 @@ class BagWriter:
         current["message_count"] += 1
         current["bytes"] += len(data)
 
+    def split(self) -> None:
+        """Close the current file and go on in a new one (rosbag2's ``split_bagfile``)."""
+        if self.closed:
+            raise BagError(f"{self.directory}: split after close")
+        self._split()
+
     def close(self) -> None:
         """Finish the MCAP file (summary, footer) and write ``metadata.yaml``. Idempotent."""
         if self.closed:
