@@ -1,6 +1,7 @@
 """Recording and replay: rosbag2 directories with MCAP storage (``aiorobot bag``).
 
-- :class:`Recorder` — a node that records topics of the running graph, losing nothing;
+- :class:`Recorder` — a node that records topics of the running graph, losing nothing (or, in
+  snapshot mode, keeps the last seconds in a :class:`SnapshotBuffer` and writes them on demand);
 - :class:`Player` — a node that plays a bag back, paced, optionally publishing ``/clock``;
 - :class:`BagWriter` / :class:`BagReader` — the files themselves (rosbags reads what we write);
 - :func:`reindex` — rebuilds a bag whose recorder was killed (``aiorobot bag reindex``);
@@ -17,6 +18,7 @@ from ._player import Player, PlayerStatistics
 from ._reader import BagReader
 from ._recorder import Recorder, RecorderStatistics
 from ._reindex import reindex
+from ._snapshot import SnapshotBuffer, SnapshotBufferStatistics
 from ._replay import ReplayResult
 from ._writer import BagWriter
 
@@ -32,6 +34,8 @@ __all__ = [
     "Recorder",
     "RecorderStatistics",
     "ReplayResult",
+    "SnapshotBuffer",
+    "SnapshotBufferStatistics",
     "TopicDiff",
     "TopicInfo",
     "check_bag",

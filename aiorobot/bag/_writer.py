@@ -121,12 +121,25 @@ class BagWriter:
             raise BagError(f"{self.directory}: split after close")
         self._split()
 
+    def checkpoint(self) -> None:
+        """Finish the current file and write ``metadata.yaml`` for the files finished so far, so the
+        directory reads as a complete bag while writing goes on in a new file (a snapshot's end)."""
+        if self.closed:
+            raise BagError(f"{self.directory}: checkpoint after close")
+        self._split()
+        write_metadata(self.directory, self._files[:-1], list(self.topics.values()))
+
     def close(self) -> None:
-        """Finish the MCAP file (summary, footer) and write ``metadata.yaml``. Idempotent."""
+        """Finish the MCAP file (summary, footer) and write ``metadata.yaml``. Idempotent.
+
+        A last file that received nothing after a split or checkpoint is removed rather than listed.
+        """
         if self.closed:
             return
         self.closed = True
         self._close_file()
+        if len(self._files) > 1 and self._files[-1]["message_count"] == 0:
+            (self.directory / self._files.pop()["path"]).unlink()
         write_metadata(self.directory, self._files, list(self.topics.values()))
 
     # -- files ------------------------------------------------------------------------

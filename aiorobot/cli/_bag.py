@@ -56,6 +56,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     rec.add_argument("--max-duration", type=positive_seconds, metavar="S", help="start a new file every S seconds (ros2's --max-bag-duration)")
     rec.add_argument("--max-size", type=_positive_float, metavar="MB", help="start a new file every MB megabytes (ros2's --max-bag-size)")
     rec.add_argument("--duration", type=positive_seconds, metavar="S", help="stop recording after S seconds (default: until Ctrl-C)")
+    rec.add_argument("--max-cache-size", type=_positive_float, metavar="MB",
+                     help="megabytes held in memory before they go to the file; with --snapshot-mode, the ring buffer's size")
+    rec.add_argument("--snapshot-mode", action="store_true",
+                     help="flight recorder: keep the last --max-cache-size MB in memory and write them only on "
+                     "~/snapshot (rosbag2_interfaces/srv/Snapshot) or a message on --snapshot-trigger")
+    rec.add_argument("--snapshot-trigger", default="", metavar="TOPIC", help="with --snapshot-mode: any message on TOPIC takes a snapshot")
     _transport_args(rec)
 
     play = sub.add_parser("play", help="play a bag into the running graph", description="Play a rosbag2 directory (ros2 bag play).")
@@ -95,6 +101,9 @@ def main(args: argparse.Namespace) -> int:
     if verb is None:
         print("aiorobot bag: error: expected a verb (record, play, info, reindex, check)", file=sys.stderr)
         return 2
+    if verb == "record" and (problem := _snapshot_problem(args)):
+        print(f"aiorobot bag record: error: {problem}", file=sys.stderr)
+        return 2
     if verb == "check":
         from ._bag_check import check_main
 
@@ -112,6 +121,14 @@ def main(args: argparse.Namespace) -> int:
         return 1
     except KeyboardInterrupt:
         return 130
+
+
+def _snapshot_problem(args: argparse.Namespace) -> str:
+    if args.snapshot_mode and not args.max_cache_size:
+        return "--snapshot-mode keeps the last --max-cache-size MB in memory: give --max-cache-size"
+    if args.snapshot_trigger and not args.snapshot_mode:
+        return "--snapshot-trigger needs --snapshot-mode"
+    return ""
 
 
 # -- info / reindex --------------------------------------------------------------------------
@@ -202,10 +219,16 @@ async def _record(args: argparse.Namespace) -> int:
         "exclude": args.exclude,
         "max_bag_size": int((args.max_size or 0) * 1e6),
         "max_bag_duration": args.max_duration or 0.0,
+        "max_cache_size": int((args.max_cache_size or 0) * 1e6),
+        "snapshot_mode": args.snapshot_mode,
+        "snapshot_trigger": args.snapshot_trigger,
     }
     if args.output:
         rec_kwargs["path"] = args.output
-    recorder = Recorder(**rec_kwargs)
+    try:
+        recorder = Recorder(**rec_kwargs)
+    except ValueError as err:
+        raise BagError(str(err)) from None
     async with _runtime(args) as rt:
         rt.add_node(recorder)
         print(f"recording to {recorder.path} (Ctrl-C to stop)", file=sys.stderr)
