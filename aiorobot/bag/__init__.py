@@ -5,6 +5,7 @@
 - :class:`Player` — a node that plays a bag back, paced, optionally publishing ``/clock``;
 - :class:`BagWriter` / :class:`BagReader` — the files themselves (rosbags reads what we write);
 - :func:`reindex` — rebuilds a bag whose recorder was killed (``aiorobot bag reindex``);
+- :func:`convert` — ``ros2 bag convert``: merge, split, filter, change storage, compress;
 - :func:`check_bag` — replays a bag's inputs into nodes in lock-step on sim time and compares
   their outputs with the recording, field by field (``aiorobot bag check``, the ``bag_replay`` fixture).
 """
@@ -12,6 +13,7 @@
 from __future__ import annotations
 
 from ._check import CheckResult, check_bag
+from ._convert import ConvertResult, OutputBag, convert, read_output_options
 from ._diff import DiffReport, FieldDifference, TopicDiff, parse_tolerance
 from ._metadata import BagError, TopicInfo
 from ._player import Player, PlayerStatistics
@@ -27,8 +29,10 @@ __all__ = [
     "BagReader",
     "BagWriter",
     "CheckResult",
+    "ConvertResult",
     "DiffReport",
     "FieldDifference",
+    "OutputBag",
     "Player",
     "PlayerStatistics",
     "Recorder",
@@ -39,6 +43,8 @@ __all__ = [
     "TopicDiff",
     "TopicInfo",
     "check_bag",
+    "convert",
     "parse_tolerance",
+    "read_output_options",
     "reindex",
 ]

@@ -62,7 +62,8 @@ class Recorder(Node):
     record with ``all``), ``max_bag_size`` (bytes per file, 0 = no split),
     ``max_bag_duration`` (seconds per file, 0 = no split), ``max_cache_size`` (bytes of messages
     held before a chunk goes to the file: what a crash can lose; default 256 KiB), ``compression``
-    (``none`` as rosbag2's default, ``zstd`` or ``lz4`` per chunk).
+    (``none`` as rosbag2's default, ``zstd`` or ``lz4`` per chunk), ``storage`` (``mcap``, or
+    ``sqlite3`` for ``.db3`` files, uncompressed).
 
     Snapshot mode (``snapshot_mode``, rosbag2's flight recorder): nothing is written while
     recording; the last ``max_cache_size`` bytes of messages (required > 0 here) are kept in a
@@ -88,6 +89,7 @@ class Recorder(Node):
         compression: str = "none",
         snapshot_mode: bool = False,
         snapshot_trigger: str = "",
+        storage: str = "mcap",
         **kwargs: Any,
     ) -> None:
         super().__init__(node_name, **kwargs)
@@ -103,6 +105,12 @@ class Recorder(Node):
         self._compression = str(self.declare_parameter("compression", compression).value)
         if self._compression not in ("none", "zstd", "lz4"):
             raise ValueError(f"recorder {self.get_name()}: compression must be 'none', 'zstd' or 'lz4', found {self._compression!r}")
+        self._storage = str(self.declare_parameter("storage", storage).value)
+        if self._storage not in ("mcap", "sqlite3"):
+            raise ValueError(f"recorder {self.get_name()}: storage must be 'mcap' or 'sqlite3', found {self._storage!r}")
+        if self._storage == "sqlite3" and self._compression != "none":
+            raise ValueError(f"recorder {self.get_name()}: compression {self._compression!r} is MCAP chunk compression; "
+                             "sqlite3 storage is written uncompressed")
         if self._max_size < 0 or self._max_duration < 0 or self._cache < 0:
             raise ValueError(
                 f"recorder {self.get_name()}: max_bag_size, max_bag_duration and max_cache_size must be >= 0"
@@ -162,6 +170,7 @@ class Recorder(Node):
             max_bag_duration_ns=int(self._max_duration * 1e9),
             chunk_size=CHUNK_SIZE if self.snapshot_mode else self._cache or CHUNK_SIZE,
             compression=self._compression,
+            storage=self._storage,
         )
         self._thread = threading.Thread(target=self._write_loop, name=f"aiorobot-recorder {self.path}", daemon=True)
         self._thread.start()

@@ -1,4 +1,4 @@
-"""Writes a rosbag2 directory: MCAP storage (``ros2`` profile, ``ros2msg`` schemas, CDR) + metadata.yaml.
+"""Writes a rosbag2 directory: MCAP (``ros2`` profile, ``ros2msg`` schemas, CDR) or SQLite3 storage + metadata.yaml.
 
 Messages go to the file chunk by chunk (``mcap``'s writer appends each finished chunk), so a
 recorder killed mid-run leaves every completed chunk readable; ``aiorobot bag reindex`` then
@@ -9,10 +9,11 @@ rebuilds the summary and ``metadata.yaml``. Splitting follows ``ros2 bag record`
 from __future__ import annotations
 
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 from .._core._qos import QoSProfile
-from ._metadata import BagError, TopicInfo, qos_yaml, write_metadata
+from ._metadata import BagError, TopicInfo, metadata_text, write_metadata
+from ._storage import COMPRESSIONS, STORAGES, McapFile, Sqlite3File, open_storage_file
 
 __all__ = ["BagWriter"]
 
@@ -21,12 +22,13 @@ CHUNK_SIZE = 256 * 1024
 
 
 class BagWriter:
-    """A rosbag2 (MCAP) bag being written. Not thread-safe: one writer thread at a time.
+    """A rosbag2 bag being written. Not thread-safe: one writer thread at a time.
 
     ``add_topic(name, type_name, qos)`` before the topic's first ``write(name, time_ns, cdr)``;
     ``close()`` finishes the file and writes ``metadata.yaml``. Use as a context manager.
     ``compression`` is the MCAP chunk compression: ``"none"`` (rosbag2's default), ``"zstd"``
     or ``"lz4"`` (``ros2 bag record --storage-preset-profile zstd_fast`` gives zstd chunks too).
+    ``storage`` is ``"mcap"`` (rosbag2's default) or ``"sqlite3"`` (``.db3``, no compression).
     """
 
     def __init__(
@@ -37,8 +39,15 @@ class BagWriter:
         max_bag_duration_ns: int = 0,
         chunk_size: int = CHUNK_SIZE,
         compression: str = "none",
+        storage: str = "mcap",
     ) -> None:
         self.directory = Path(directory)
+        if storage not in STORAGES:
+            raise BagError(f"storage: expected 'mcap' or 'sqlite3', found {storage!r}")
+        if compression not in COMPRESSIONS:
+            raise BagError(f"compression: expected 'none', 'zstd' or 'lz4', found {compression!r}")
+        if storage == "sqlite3" and compression != "none":
+            raise BagError(f"compression {compression!r} is MCAP chunk compression; sqlite3 storage is written uncompressed")
         if self.directory.exists():
             raise BagError(f"{self.directory}: exists already; choose another output directory (-o) or remove it")
         try:
@@ -48,15 +57,12 @@ class BagWriter:
         self.max_bag_size = max_bag_size
         self.max_bag_duration_ns = max_bag_duration_ns
         self.chunk_size = chunk_size
-        if compression not in ("none", "zstd", "lz4"):
-            raise BagError(f"compression: expected 'none', 'zstd' or 'lz4', found {compression!r}")
         self.compression = compression
+        self.storage = storage
         self.topics: dict[str, TopicInfo] = {}
         self._files: list[dict[str, Any]] = []
-        self._stream: IO[bytes] | None = None
-        self._mcap: Any = None
-        self._channels: dict[str, int] = {}
-        self._schemas: dict[str, int] = {}
+        self._file: McapFile | Sqlite3File | None = None
+        self._definitions: dict[str, str] = {}
         self._sequence: dict[str, int] = {}
         self.closed = False
         self._open_file()
@@ -80,8 +86,11 @@ class BagWriter:
 
     # -- topics and messages ------------------------------------------------------------
 
-    def add_topic(self, name: str, type_name: str, qos: QoSProfile | None = None) -> None:
-        """Declare ``name`` with its ROS type name (``"geometry_msgs/msg/Twist"``) and offered QoS."""
+    def add_topic(self, name: str, type_name: str, qos: QoSProfile | None = None, *, qos_text: str = "") -> None:
+        """Declare ``name`` with its ROS type name (``"geometry_msgs/msg/Twist"``) and offered QoS.
+
+        ``qos_text``: the offered QoS profiles as YAML, kept verbatim (a bag being converted).
+        """
         from aiorobot.msgs import type_hash
 
         if name in self.topics:
@@ -91,7 +100,7 @@ class BagWriter:
                     f"a second type {type_name} on the same topic cannot be recorded"
                 )
             return
-        self.topics[name] = TopicInfo(name, type_name, type_hash(type_name), qos or QoSProfile())
+        self.topics[name] = TopicInfo(name, type_name, type_hash(type_name), qos or QoSProfile(), qos_text=qos_text)
         self._sequence[name] = 0
         self._register(name)
 
@@ -105,7 +114,8 @@ class BagWriter:
             self._split()
             current = self._files[-1]
         self._sequence[topic] += 1
-        self._mcap.add_message(self._channels[topic], log_time=time_ns, data=data, publish_time=time_ns, sequence=self._sequence[topic])
+        assert self._file is not None
+        self._file.write(topic, time_ns, data, self._sequence[topic])
         info.message_count += 1
         if current["message_count"] == 0:
             current["start_ns"] = time_ns
@@ -127,7 +137,7 @@ class BagWriter:
         if self.closed:
             raise BagError(f"{self.directory}: checkpoint after close")
         self._split()
-        write_metadata(self.directory, self._files[:-1], list(self.topics.values()))
+        write_metadata(self.directory, self._files[:-1], list(self.topics.values()), storage=self.storage)
 
     def close(self) -> None:
         """Finish the MCAP file (summary, footer) and write ``metadata.yaml``. Idempotent.
@@ -140,7 +150,7 @@ class BagWriter:
         self._close_file()
         if len(self._files) > 1 and self._files[-1]["message_count"] == 0:
             (self.directory / self._files.pop()["path"]).unlink()
-        write_metadata(self.directory, self._files, list(self.topics.values()))
+        write_metadata(self.directory, self._files, list(self.topics.values()), storage=self.storage)
 
     # -- files ------------------------------------------------------------------------
 
@@ -152,16 +162,10 @@ class BagWriter:
         return bool(self.max_bag_duration_ns and time_ns - current["start_ns"] >= self.max_bag_duration_ns)
 
     def _open_file(self) -> None:
-        from mcap.writer import CompressionType, Writer
-
-        name = f"{self.directory.name}_{len(self._files)}.mcap"
-        self._stream = open(self.directory / name, "wb")  # noqa: SIM115 - closed in _close_file
-        kind = {"none": CompressionType.NONE, "zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4}[self.compression]
-        self._mcap = Writer(self._stream, chunk_size=self.chunk_size, compression=kind)
-        self._mcap.start(profile="ros2", library="aiorobot")
-        self._files.append({"path": name, "start_ns": 0, "duration_ns": 0, "message_count": 0, "bytes": 0})
-        self._channels.clear()
-        self._schemas.clear()
+        self._file = open_storage_file(
+            self.directory, len(self._files), self.storage, chunk_size=self.chunk_size, compression=self.compression
+        )
+        self._files.append({"path": self._file.path.name, "start_ns": 0, "duration_ns": 0, "message_count": 0, "bytes": 0})
         for topic in self.topics:
             self._register(topic)
 
@@ -169,21 +173,15 @@ class BagWriter:
         from aiorobot.msgs import message_definition
 
         info = self.topics[topic]
-        schema = self._schemas.get(info.type)
-        if schema is None:
-            schema = self._mcap.register_schema(info.type, "ros2msg", message_definition(info.type).encode())
-            self._schemas[info.type] = schema
-        self._channels[topic] = self._mcap.register_channel(
-            topic, "cdr", schema, metadata={"offered_qos_profiles": qos_yaml(info.qos)}
-        )
+        if info.type not in self._definitions:
+            self._definitions[info.type] = message_definition(info.type)
+        assert self._file is not None
+        self._file.register(topic, info, self._definitions[info.type])
 
     def _close_file(self) -> None:
-        if self._mcap is not None:
-            self._mcap.finish()
-            self._mcap = None
-        if self._stream is not None:
-            self._stream.close()
-            self._stream = None
+        if self._file is not None:
+            self._file.close(metadata_text(self._files, list(self.topics.values()), storage=self.storage))
+            self._file = None
 
     def _split(self) -> None:
         self._close_file()

@@ -1,8 +1,9 @@
-"""``aiorobot bag record|play|info|reindex|check``: ``ros2 bag`` for aiorobot graphs.
+"""``aiorobot bag record|play|info|reindex|check|convert``: ``ros2 bag`` for aiorobot graphs.
 
 ``record`` and ``play`` join the running graph through a transport (``--transport``, zenoh by
 default: other processes are only reachable over the network); ``info`` and ``reindex`` work
-on the directory alone; ``check`` (``_bag_check``) replays a bag into nodes in this process.
+on the directory alone; ``check`` (``_bag_check``) replays a bag into nodes in this process;
+``convert`` (``_bag_convert``) rewrites bags as a rosbag2 output-options file says.
 """
 
 from __future__ import annotations
@@ -61,6 +62,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     rec.add_argument("--snapshot-mode", action="store_true",
                      help="flight recorder: keep the last --max-cache-size MB in memory and write them only on "
                      "~/snapshot (rosbag2_interfaces/srv/Snapshot) or a message on --snapshot-trigger")
+    rec.add_argument("-s", "--storage", default="mcap", choices=("mcap", "sqlite3"), help="storage format (default mcap)")
+    rec.add_argument("--compression-format", default="none", choices=("none", "zstd", "lz4"),
+                     help="MCAP chunk compression (default none, as rosbag2); readable by rosbags, mcap and ros2 bag")
     rec.add_argument("--snapshot-trigger", default="", metavar="TOPIC", help="with --snapshot-mode: any message on TOPIC takes a snapshot")
     _transport_args(rec)
 
@@ -84,8 +88,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     reidx.add_argument("bag", type=Path, metavar="DIR")
 
     from ._bag_check import add_check_arguments
+    from ._bag_convert import add_convert_arguments
 
     add_check_arguments(sub)
+    add_convert_arguments(sub)
 
 
 def _transport_args(parser: argparse.ArgumentParser) -> None:
@@ -99,15 +105,19 @@ def main(args: argparse.Namespace) -> int:
 
     verb = args.bag_command
     if verb is None:
-        print("aiorobot bag: error: expected a verb (record, play, info, reindex, check)", file=sys.stderr)
+        print("aiorobot bag: error: expected a verb (record, play, info, reindex, check, convert)", file=sys.stderr)
         return 2
-    if verb == "record" and (problem := _snapshot_problem(args)):
+    if verb == "record" and (problem := _record_problem(args)):
         print(f"aiorobot bag record: error: {problem}", file=sys.stderr)
         return 2
     if verb == "check":
         from ._bag_check import check_main
 
         return check_main(args)
+    if verb == "convert":
+        from ._bag_convert import convert_main
+
+        return convert_main(args)
     try:
         if verb == "info":
             return _info(args.bag)
@@ -123,11 +133,13 @@ def main(args: argparse.Namespace) -> int:
         return 130
 
 
-def _snapshot_problem(args: argparse.Namespace) -> str:
+def _record_problem(args: argparse.Namespace) -> str:
     if args.snapshot_mode and not args.max_cache_size:
         return "--snapshot-mode keeps the last --max-cache-size MB in memory: give --max-cache-size"
     if args.snapshot_trigger and not args.snapshot_mode:
         return "--snapshot-trigger needs --snapshot-mode"
+    if args.storage == "sqlite3" and args.compression_format != "none":
+        return f"--compression-format {args.compression_format} is MCAP chunk compression; --storage sqlite3 is written uncompressed"
     return ""
 
 
@@ -222,6 +234,8 @@ async def _record(args: argparse.Namespace) -> int:
         "max_cache_size": int((args.max_cache_size or 0) * 1e6),
         "snapshot_mode": args.snapshot_mode,
         "snapshot_trigger": args.snapshot_trigger,
+        "storage": args.storage,
+        "compression": args.compression_format,
     }
     if args.output:
         rec_kwargs["path"] = args.output
