@@ -6,6 +6,7 @@
 - :class:`BagWriter` / :class:`BagReader` — the files themselves (rosbags reads what we write);
 - :func:`reindex` — rebuilds a bag whose recorder was killed (``aiorobot bag reindex``);
 - :func:`convert` — ``ros2 bag convert``: merge, split, filter, change storage, compress;
+- :func:`sweep` — the same replay for several parameter variants in worker processes, with figures;
 - :func:`check_bag` — replays a bag's inputs into nodes in lock-step on sim time and compares
   their outputs with the recording, field by field (``aiorobot bag check``, the ``bag_replay`` fixture).
 """
@@ -20,6 +21,7 @@ from ._player import Player, PlayerStatistics
 from ._reader import BagReader
 from ._recorder import Recorder, RecorderStatistics
 from ._reindex import reindex
+from ._sweep import TopicFigures, VariantResult, odometry_rmse, sweep, topic_figures, variants_from_params
 from ._snapshot import SnapshotBuffer, SnapshotBufferStatistics
 from ._replay import ReplayResult
 from ._writer import BagWriter
@@ -41,10 +43,16 @@ __all__ = [
     "SnapshotBuffer",
     "SnapshotBufferStatistics",
     "TopicDiff",
+    "TopicFigures",
     "TopicInfo",
+    "VariantResult",
     "check_bag",
     "convert",
+    "odometry_rmse",
     "parse_tolerance",
     "read_output_options",
     "reindex",
+    "sweep",
+    "topic_figures",
+    "variants_from_params",
 ]

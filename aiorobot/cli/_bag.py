@@ -1,9 +1,10 @@
-"""``aiorobot bag record|play|info|reindex|check|convert``: ``ros2 bag`` for aiorobot graphs.
+"""``aiorobot bag record|play|info|reindex|check|convert|sweep``: ``ros2 bag`` for aiorobot graphs.
 
 ``record`` and ``play`` join the running graph through a transport (``--transport``, zenoh by
 default: other processes are only reachable over the network); ``info`` and ``reindex`` work
 on the directory alone; ``check`` (``_bag_check``) replays a bag into nodes in this process;
-``convert`` (``_bag_convert``) rewrites bags as a rosbag2 output-options file says.
+``convert`` (``_bag_convert``) rewrites bags as a rosbag2 output-options file says; ``sweep``
+(``_bag_sweep``) replays a bag into parameter variants in worker processes.
 """
 
 from __future__ import annotations
@@ -89,9 +90,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     from ._bag_check import add_check_arguments
     from ._bag_convert import add_convert_arguments
+    from ._bag_sweep import add_sweep_arguments
 
     add_check_arguments(sub)
     add_convert_arguments(sub)
+    add_sweep_arguments(sub)
 
 
 def _transport_args(parser: argparse.ArgumentParser) -> None:
@@ -105,7 +108,7 @@ def main(args: argparse.Namespace) -> int:
 
     verb = args.bag_command
     if verb is None:
-        print("aiorobot bag: error: expected a verb (record, play, info, reindex, check, convert)", file=sys.stderr)
+        print("aiorobot bag: error: expected a verb (record, play, info, reindex, check, convert, sweep)", file=sys.stderr)
         return 2
     if verb == "record" and (problem := _record_problem(args)):
         print(f"aiorobot bag record: error: {problem}", file=sys.stderr)
@@ -118,6 +121,10 @@ def main(args: argparse.Namespace) -> int:
         from ._bag_convert import convert_main
 
         return convert_main(args)
+    if verb == "sweep":
+        from ._bag_sweep import sweep_main
+
+        return sweep_main(args)
     try:
         if verb == "info":
             return _info(args.bag)
