@@ -31,6 +31,16 @@ def _acting(action: Any) -> Any:
     return handle
 
 
+def _answering(field: str, getter: Any) -> Any:
+    """A handler that answers with ``response.<field> = getter()``."""
+
+    def handle(request: Any, response: Any) -> Any:
+        setattr(response, field, getter())
+        return response
+
+    return handle
+
+
 def _ns(stamp: Any) -> int:
     return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
 
@@ -38,14 +48,6 @@ def _ns(stamp: Any) -> int:
 def create_player_services(player: Any) -> None:
     """rosbag2_transport's ``Player::create_control_services`` on an aiorobot :class:`Player`."""
     from aiorobot.msgs import rosbag2_interfaces as srv
-
-    def is_paused(request: Any, response: Any) -> Any:
-        response.paused = player.is_paused()
-        return response
-
-    def get_rate(request: Any, response: Any) -> Any:
-        response.rate = player.get_rate()
-        return response
 
     def set_rate(request: Any, response: Any) -> Any:
         try:
@@ -78,8 +80,8 @@ def create_player_services(player: Any) -> None:
         ("~/pause", srv.Pause, _acting(player.pause)),
         ("~/resume", srv.Resume, _acting(player.resume)),
         ("~/toggle_paused", srv.TogglePaused, _acting(player.toggle_pause)),
-        ("~/is_paused", srv.IsPaused, is_paused),
-        ("~/get_rate", srv.GetRate, get_rate),
+        ("~/is_paused", srv.IsPaused, _answering("paused", player.is_paused)),
+        ("~/get_rate", srv.GetRate, _answering("rate", player.get_rate)),
         ("~/set_rate", srv.SetRate, set_rate),
         ("~/seek", srv.Seek, seek),
         ("~/play_next", srv.PlayNext, play_next),
@@ -93,21 +95,13 @@ def create_recorder_services(recorder: Any, *, snapshot: bool = False) -> None:
     """rosbag2_transport's recorder services on an aiorobot :class:`Recorder`."""
     from aiorobot.msgs import rosbag2_interfaces as srv
 
-    def is_paused(request: Any, response: Any) -> Any:
-        response.paused = recorder.is_paused()
-        return response
-
-    def take_snapshot(request: Any, response: Any) -> Any:
-        response.success = recorder.snapshot()
-        return response
-
     services = [
         ("~/pause", srv.Pause, _acting(recorder.pause)),
         ("~/resume", srv.Resume, _acting(recorder.resume)),
-        ("~/is_paused", srv.IsPaused, is_paused),
+        ("~/is_paused", srv.IsPaused, _answering("paused", recorder.is_paused)),
         ("~/split_bagfile", srv.SplitBagfile, _acting(recorder.split_bagfile)),
     ]
     if snapshot:
-        services.append(("~/snapshot", srv.Snapshot, take_snapshot))
+        services.append(("~/snapshot", srv.Snapshot, _answering("success", recorder.snapshot)))
     for name, kind, handler in services:
         recorder.create_service(kind, name, handler)

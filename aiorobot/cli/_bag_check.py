@@ -15,9 +15,15 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["add_check_arguments", "check_main"]
+__all__ = ["add_check_arguments", "check_main", "usage_error"]
 
 EXIT_USAGE = 2
+
+
+def usage_error(verb: str, text: str) -> int:
+    """Print ``aiorobot bag VERB: error: TEXT`` (one line) and return the usage status, 2."""
+    print(f"aiorobot bag {verb}: error: {text}", file=sys.stderr)
+    return EXIT_USAGE
 _PARAM = re.compile(r"^[A-Za-z_][\w.]*:=.*$")
 
 
@@ -70,8 +76,7 @@ def check_main(args: argparse.Namespace) -> int:
     from ._run_node import _UsageError, build_node
 
     def usage(text: str) -> int:
-        print(f"aiorobot bag check: error: {text}", file=sys.stderr)
-        return EXIT_USAGE
+        return usage_error("check", text)
 
     ros_args = ["--ros-args"]
     if args.params_file is not None:

@@ -15,8 +15,6 @@ from typing import Any
 
 __all__ = ["add_convert_arguments", "convert_main"]
 
-EXIT_USAGE = 2
-
 
 def add_convert_arguments(sub: Any) -> None:
     conv = sub.add_parser(
@@ -32,9 +30,10 @@ def add_convert_arguments(sub: Any) -> None:
 def convert_main(args: argparse.Namespace) -> int:
     from aiorobot.bag import BagError, BagReader, convert, read_output_options
 
+    from ._bag_check import usage_error
+
     def usage(text: str) -> int:
-        print(f"aiorobot bag convert: error: {text}", file=sys.stderr)
-        return EXIT_USAGE
+        return usage_error("convert", text)
 
     inputs = []
     for item in args.inputs:

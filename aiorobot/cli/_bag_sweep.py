@@ -18,8 +18,6 @@ from typing import Any
 
 __all__ = ["add_sweep_arguments", "build_variant_nodes", "sweep_main"]
 
-EXIT_USAGE = 2
-
 
 def add_sweep_arguments(sub: Any) -> None:
     from ._bag_check import _node_spec, _param
@@ -58,9 +56,10 @@ def sweep_main(args: argparse.Namespace) -> int:
 
     from ._run_node import _UsageError
 
+    from ._bag_check import usage_error
+
     def usage(text: str) -> int:
-        print(f"aiorobot bag sweep: error: {text}", file=sys.stderr)
-        return EXIT_USAGE
+        return usage_error("sweep", text)
 
     base: tuple[str, ...] = ()
     if args.params_file is not None:
