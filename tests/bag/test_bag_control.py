@@ -116,3 +116,38 @@ async def test_recorder_services_pause_resume_and_split(tmp_path: Path) -> None:
     with BagReader(out) as reader:
         assert [deserialize(d, String).data for _, _, d in reader.messages()] == ["before", "after", "second file"]
         assert reader.message_count == 3
+
+
+async def test_seek_and_set_rate_while_playing_take_effect_where_playback_is(tmp_path: Path) -> None:
+    import asyncio
+
+    bag = _bag(tmp_path / "ten")
+    async with Runtime(handle_signals=False) as rt:
+        probe = rt.add_node(Node("probe"))
+        got: list[str] = []
+        arrived = asyncio.Event()
+
+        def on_message(msg: Any) -> None:
+            got.append(msg.data)
+            arrived.set()
+
+        probe.create_subscription(String, "/chatter", on_message, 50)
+        rt.add_node(Player(path=str(bag)))
+
+        taken = 0
+
+        async def next_message() -> str:
+            nonlocal taken
+            while len(got) <= taken:  # generous bound: each one is due at once
+                await asyncio.wait_for(arrived.wait(), 10.0)
+                arrived.clear()
+            taken += 1
+            return got[taken - 1]
+
+        assert await next_message() == "m0"  # the first message plays at once; the next is 10 s away
+        await _call(rt, probe, srv.Seek, "/player/seek", time=TimeMsg(sec=170))
+        assert await next_message() == "m7"  # due at once: playback goes on from the seek
+        await _call(rt, probe, srv.SetRate, "/player/set_rate", rate=10_000.0)
+        assert await next_message() == "m8"  # 10 s of bag at 10000x: 1 ms
+        assert await next_message() == "m9"
+        assert got == ["m0", "m7", "m8", "m9"]
