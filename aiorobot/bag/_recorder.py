@@ -32,6 +32,8 @@ __all__ = ["Recorder", "RecorderStatistics", "default_bag_name"]
 _STOP = object()
 _SPLIT = object()
 _SNAPSHOT = object()
+#: How often (wall seconds) ``snapshot_on_failure`` looks at the runtime's failure counts.
+_FAILURE_POLL_SEC = 0.2
 #: How long the writer thread lets messages gather between batches.
 _BATCH_SEC = 0.005
 
@@ -68,7 +70,8 @@ class Recorder(Node):
     Snapshot mode (``snapshot_mode``, rosbag2's flight recorder): nothing is written while
     recording; the last ``max_cache_size`` bytes of messages (required > 0 here) are kept in a
     :class:`SnapshotBuffer`, and :meth:`snapshot` (the ``~/snapshot`` service, or any message on
-    the ``snapshot_trigger`` topic) writes them. Each snapshot ends its storage file and rewrites
+    the ``snapshot_trigger`` topic, or with ``snapshot_on_failure`` a callback failure, a failed
+    start or a loop stall in this recorder's runtime) writes them. Each snapshot ends its storage file and rewrites
     ``metadata.yaml``, so the directory is a complete, readable bag as soon as it is written.
 
     rosbag2's recorder services (``~/pause``, ``~/resume``, ``~/is_paused``, ``~/split_bagfile``)
@@ -89,6 +92,7 @@ class Recorder(Node):
         compression: str = "none",
         snapshot_mode: bool = False,
         snapshot_trigger: str = "",
+        snapshot_on_failure: bool = False,
         storage: str = "mcap",
         **kwargs: Any,
     ) -> None:
@@ -117,6 +121,7 @@ class Recorder(Node):
             )
         self.snapshot_mode = bool(self.declare_parameter("snapshot_mode", snapshot_mode).value)
         self._trigger = str(self.declare_parameter("snapshot_trigger", snapshot_trigger).value)
+        self._on_failure = bool(self.declare_parameter("snapshot_on_failure", snapshot_on_failure).value)
         self._ring: SnapshotBuffer | None = None
         if self.snapshot_mode:
             if self._cache <= 0:
@@ -125,8 +130,9 @@ class Recorder(Node):
                     f"so max_cache_size must be > 0, found {self._cache}"
                 )
             self._ring = SnapshotBuffer(self._cache)
-        elif self._trigger:
-            raise ValueError(f"recorder {self.get_name()}: snapshot_trigger {self._trigger!r} needs snapshot_mode")
+        elif self._trigger or self._on_failure:
+            what = f"snapshot_trigger {self._trigger!r}" if self._trigger else "snapshot_on_failure"
+            raise ValueError(f"recorder {self.get_name()}: {what} needs snapshot_mode")
         if Path(self.path).exists():
             raise BagError(f"{self.path}: exists already; choose another output directory or remove it")
         self._taps: dict[str, Tap] = {}
@@ -185,6 +191,10 @@ class Recorder(Node):
             f"recording {'all topics' if self.all_topics else ', '.join(self.topics)} to {self.path}{mode}"
         )
 
+    async def on_start(self) -> None:
+        if self._on_failure:
+            self.create_task(self._watch_failures(), name=f"aiorobot-recorder {self.path} failure trigger")
+
     async def on_shutdown(self) -> None:
         self.stop()
 
@@ -235,6 +245,24 @@ class Recorder(Node):
             return False
         self._queue.put((_SNAPSHOT, self._ring.take()))
         return True
+
+    async def _watch_failures(self) -> None:
+        """Take a snapshot whenever the runtime counts a new failure, failed start or stall (checked
+        every ``_FAILURE_POLL_SEC`` of wall time, so a stall is caught as soon as the loop runs again)."""
+        import asyncio
+
+        def trouble() -> int:
+            stats = self.runtime.statistics()
+            return sum(stats["failures"].values()) + len(stats["failed_starts"]) + sum(stats["stalls"].values())
+
+        seen = trouble()
+        while True:
+            await asyncio.sleep(_FAILURE_POLL_SEC)
+            now = trouble()
+            if now > seen:
+                self.get_logger().warning(f"the runtime counted {now - seen} new failure(s) or stall(s): taking a snapshot")
+                self.snapshot()
+            seen = now
 
     def _add_trigger(self, pub: Publisher[Any]) -> None:
         """Any message on the trigger topic takes a snapshot (in the publishing thread: the buffer and the queue are thread-safe)."""

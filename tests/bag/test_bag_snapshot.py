@@ -110,3 +110,33 @@ def test_cli_snapshot_mode_needs_a_cache_size() -> None:
     assert done.returncode == 2
     assert done.stderr == ("aiorobot bag record: error: --snapshot-mode keeps the last --max-cache-size MB in memory: "
                            "give --max-cache-size\n")
+
+
+async def test_a_failing_callback_takes_a_snapshot_with_snapshot_on_failure(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    out = tmp_path / "crash"
+    async with Runtime(handle_signals=False) as rt:
+        talker = rt.add_node(Node("talker"))
+        pub = talker.create_publisher(String, "/fast", 10)
+        listener = rt.add_node(Node("listener"))
+
+        def fragile(msg: String) -> None:
+            if msg.data == "boom":
+                raise RuntimeError("the listener broke")
+
+        listener.create_subscription(String, "/fast", fragile, 10)
+        recorder = rt.add_node(Recorder(path=str(out), topics=["/fast"], snapshot_mode=True, max_cache_size=10 * SIZE,
+                                        snapshot_on_failure=True))
+        await rt.settle()
+        for _ in range(20):
+            pub.publish(PAYLOAD)
+        await rt.settle()
+        assert recorder.statistics().snapshots == 0  # nothing went wrong yet
+        pub.publish(String(data="boom"))
+        await _wait_for(lambda: recorder.statistics().snapshots == 1, "the snapshot after the failure")
+        recorder.stop()
+    from rosbags.highlevel import AnyReader
+
+    with AnyReader([out]) as reader:
+        data = [reader.deserialize(raw, c.msgtype).data for c, _, raw in reader.messages()]
+    assert data[-1] == "boom" and len(data) == 10  # the last max_cache_size worth, up to the failure
+    assert any("taking a snapshot" in r.getMessage() for r in caplog.records)
