@@ -9,10 +9,10 @@ The YAML is rosbag2's: a top-level ``output_bags`` list, each entry ``StorageOpt
 - topic selection as ``ros2 bag record``: ``all_topics``, ``topics``, ``topic_types``, ``regex``;
   ``exclude_regex``, ``exclude_topics``, ``exclude_topic_types``; service-event topics
   (``.../_service_event``) only through ``all_services`` / ``services`` / ``exclude_services``;
-- compression: ``storage_preset_profile: zstd_fast`` / ``zstd_small``, or ``compression_format:
-  zstd`` / ``lz4`` with ``compression_mode`` empty or ``chunk``, give MCAP chunk compression
-  (rosbag2's ``file`` and ``message`` modes are refused: aiorobot writes chunk compression, which
-  rosbags, mcap and ``ros2 bag`` read without a decompression step).
+- compression: ``compression_mode: file`` or ``message`` with ``compression_format: zstd`` is
+  rosbag2's own compression (``<file>.zstd`` files, or each message); ``storage_preset_profile:
+  zstd_fast`` / ``zstd_small``, or ``compression_format: zstd`` / ``lz4`` without a mode (or with
+  ``chunk``), give MCAP chunk compression, which rosbags, mcap and ``ros2 bag`` read directly.
 
 Keys rosbag2 accepts that change nothing here (``storage_config_uri``, ``compression_queue_size``,
 ``compression_threads``, ``include_hidden_topics``, ``include_unpublished_topics``,
@@ -54,6 +54,7 @@ class OutputBag:
     max_bagfile_size: int = 0
     max_bagfile_duration_sec: float = 0.0
     compression: str = "none"
+    compression_mode: str = ""
     all_topics: bool = False
     topics: tuple[str, ...] = ()
     topic_types: tuple[str, ...] = ()
@@ -152,19 +153,23 @@ def _output_bag(path: Path, i: int, entry: Any) -> OutputBag:
     compression = _PRESETS[preset]
     mode = get("compression_mode", str, "", "'' or 'chunk'").lower()
     cfmt = get("compression_format", str, "", "'zstd' or 'lz4'")
-    if mode in ("file", "message"):
-        raise BagError(
-            f"{where}.compression_mode: {mode!r} (rosbag2's per-{mode} zstd) is not written by aiorobot; "
-            f"remove compression_mode and keep compression_format: zstd for MCAP chunk compression"
-        )
-    if mode not in ("", "none", "chunk"):
-        raise BagError(f"{where}.compression_mode: expected '' or 'chunk', found {mode!r}")
-    if cfmt:
+    if mode not in ("", "none", "chunk", "file", "message"):
+        raise BagError(f"{where}.compression_mode: expected 'file', 'message', 'chunk' or '', found {mode!r}")
+    file_mode = mode if mode in ("file", "message") else ""
+    if file_mode:
+        if cfmt != "zstd":
+            raise BagError(f"{where}.compression_format: compression_mode {mode!r} needs 'zstd' (rosbag2's only format), found {cfmt!r}")
+        if compression != "none":
+            raise BagError(f"{where}: storage_preset_profile {preset!r} compresses the chunks; with compression_mode {mode!r} leave it out")
+    elif cfmt:
         if cfmt not in ("zstd", "lz4"):
             raise BagError(f"{where}.compression_format: expected 'zstd' or 'lz4', found {cfmt!r}")
         compression = cfmt
     if storage == "sqlite3" and compression != "none":
-        raise BagError(f"{where}: {compression} is MCAP chunk compression; storage_id sqlite3 is written uncompressed")
+        raise BagError(
+            f"{where}: {compression} without compression_mode is MCAP chunk compression; for storage_id sqlite3 "
+            f"use compression_mode: file or message"
+        )
     size = get("max_bagfile_size", int, 0, "a number of bytes >= 0")
     duration = get("max_bagfile_duration", (int, float), 0, "a number of seconds >= 0")
     if size < 0 or duration < 0:
@@ -176,6 +181,7 @@ def _output_bag(path: Path, i: int, entry: Any) -> OutputBag:
             raise BagError(f"{where}.{key}: not a regular expression ({err})") from None
     return OutputBag(
         uri=uri, storage=storage, max_bagfile_size=size, max_bagfile_duration_sec=float(duration), compression=compression,
+        compression_mode=file_mode,
         all_topics=get("all_topics", bool, False, "true or false"), topics=names("topics"), topic_types=names("topic_types"),
         regex=get("regex", str, "", "a regular expression"), exclude_regex=get("exclude_regex", str, "", "a regular expression"),
         exclude_topics=names("exclude_topics"), exclude_topic_types=names("exclude_topic_types"),
@@ -228,8 +234,8 @@ def _write(readers: list[BagReader], types: dict[str, tuple[str, Any, Any]], out
     writers: list[tuple[BagWriter, set[str]]] = []
     try:
         for out, topics, _ in plans:
-            writer = BagWriter(out.uri, storage=out.storage, compression=out.compression, max_bag_size=out.max_bagfile_size,
-                               max_bag_duration_ns=int(out.max_bagfile_duration_sec * 1e9))
+            writer = BagWriter(out.uri, storage=out.storage, compression=out.compression, compression_mode=out.compression_mode,
+                               max_bag_size=out.max_bagfile_size, max_bag_duration_ns=int(out.max_bagfile_duration_sec * 1e9))
             for topic in topics:
                 _, info, _ = types[topic]
                 writer.add_topic(topic, info.type, info.qos, qos_text=info.qos_text)

@@ -101,18 +101,22 @@ def write_metadata(
     topics: list[TopicInfo],
     *,
     storage: str = "mcap",
+    compression_mode: str = "",
 ) -> None:
     """Write ``directory/metadata.yaml`` in rosbag2's version 9 format (atomically: temp file + rename).
 
     ``files``: one dict per storage file, ``{"path", "start_ns", "duration_ns", "message_count"}``.
     """
     tmp = directory / (METADATA + ".tmp")
-    tmp.write_text(metadata_text(files, topics, storage=storage), encoding="utf8")
+    tmp.write_text(metadata_text(files, topics, storage=storage, compression_mode=compression_mode), encoding="utf8")
     tmp.replace(directory / METADATA)
 
 
-def metadata_text(files: list[dict[str, Any]], topics: list[TopicInfo], *, storage: str = "mcap") -> str:
-    """The ``metadata.yaml`` text (version 9) of a bag made of ``files`` holding ``topics``."""
+def metadata_text(files: list[dict[str, Any]], topics: list[TopicInfo], *, storage: str = "mcap", compression_mode: str = "") -> str:
+    """The ``metadata.yaml`` text (version 9) of a bag made of ``files`` holding ``topics``.
+
+    ``compression_mode``: rosbag2's ``FILE`` or ``MESSAGE`` zstd compression, ``""`` for none.
+    """
     from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 
     start = min((f["start_ns"] for f in files if f["message_count"]), default=0)
@@ -138,8 +142,8 @@ def metadata_text(files: list[dict[str, Any]], topics: list[TopicInfo], *, stora
                 }
                 for t in topics
             ],
-            "compression_format": "",
-            "compression_mode": "",
+            "compression_format": "zstd" if compression_mode else "",
+            "compression_mode": compression_mode,
             "files": [
                 {
                     "path": f["path"],

@@ -65,7 +65,8 @@ class Recorder(Node):
     ``max_bag_duration`` (seconds per file, 0 = no split), ``max_cache_size`` (bytes of messages
     held before a chunk goes to the file: what a crash can lose; default 256 KiB), ``compression``
     (``none`` as rosbag2's default, ``zstd`` or ``lz4`` per chunk), ``storage`` (``mcap``, or
-    ``sqlite3`` for ``.db3`` files, uncompressed).
+    ``sqlite3`` for ``.db3`` files), ``compression_mode`` (rosbag2's zstd per ``file`` or per
+    ``message``, either storage; ``compression`` then stays ``none``).
 
     Snapshot mode (``snapshot_mode``, rosbag2's flight recorder): nothing is written while
     recording; the last ``max_cache_size`` bytes of messages (required > 0 here) are kept in a
@@ -94,6 +95,7 @@ class Recorder(Node):
         snapshot_trigger: str = "",
         snapshot_on_failure: bool = False,
         storage: str = "mcap",
+        compression_mode: str = "",
         **kwargs: Any,
     ) -> None:
         super().__init__(node_name, **kwargs)
@@ -112,6 +114,12 @@ class Recorder(Node):
         self._storage = str(self.declare_parameter("storage", storage).value)
         if self._storage not in ("mcap", "sqlite3"):
             raise ValueError(f"recorder {self.get_name()}: storage must be 'mcap' or 'sqlite3', found {self._storage!r}")
+        self._compression_mode = str(self.declare_parameter("compression_mode", compression_mode).value)
+        if self._compression_mode not in ("", "file", "message"):
+            raise ValueError(f"recorder {self.get_name()}: compression_mode must be '', 'file' or 'message', found {self._compression_mode!r}")
+        if self._compression_mode and self._compression != "none":
+            raise ValueError(f"recorder {self.get_name()}: compression_mode {self._compression_mode!r} compresses with zstd "
+                             f"already; leave compression at 'none'")
         if self._storage == "sqlite3" and self._compression != "none":
             raise ValueError(f"recorder {self.get_name()}: compression {self._compression!r} is MCAP chunk compression; "
                              "sqlite3 storage is written uncompressed")
@@ -177,6 +185,7 @@ class Recorder(Node):
             chunk_size=CHUNK_SIZE if self.snapshot_mode else self._cache or CHUNK_SIZE,
             compression=self._compression,
             storage=self._storage,
+            compression_mode=self._compression_mode,
         )
         self._thread = threading.Thread(target=self._write_loop, name=f"aiorobot-recorder {self.path}", daemon=True)
         self._thread.start()

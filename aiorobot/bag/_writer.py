@@ -29,6 +29,8 @@ class BagWriter:
     ``compression`` is the MCAP chunk compression: ``"none"`` (rosbag2's default), ``"zstd"``
     or ``"lz4"`` (``ros2 bag record --storage-preset-profile zstd_fast`` gives zstd chunks too).
     ``storage`` is ``"mcap"`` (rosbag2's default) or ``"sqlite3"`` (``.db3``, no compression).
+    ``compression_mode`` is rosbag2's own zstd compression instead: ``"file"`` (each finished
+    storage file becomes ``<file>.zstd``) or ``"message"`` (each message's bytes), either storage.
     """
 
     def __init__(
@@ -40,12 +42,17 @@ class BagWriter:
         chunk_size: int = CHUNK_SIZE,
         compression: str = "none",
         storage: str = "mcap",
+        compression_mode: str = "",
     ) -> None:
         self.directory = Path(directory)
         if storage not in STORAGES:
             raise BagError(f"storage: expected 'mcap' or 'sqlite3', found {storage!r}")
         if compression not in COMPRESSIONS:
             raise BagError(f"compression: expected 'none', 'zstd' or 'lz4', found {compression!r}")
+        if compression_mode not in ("", "file", "message"):
+            raise BagError(f"compression_mode: expected '', 'file' or 'message' (zstd, as rosbag2), found {compression_mode!r}")
+        if compression_mode and compression != "none":
+            raise BagError(f"compression_mode {compression_mode!r} compresses with zstd already; leave the MCAP chunks uncompressed")
         if storage == "sqlite3" and compression != "none":
             raise BagError(f"compression {compression!r} is MCAP chunk compression; sqlite3 storage is written uncompressed")
         if self.directory.exists():
@@ -59,6 +66,12 @@ class BagWriter:
         self.chunk_size = chunk_size
         self.compression = compression
         self.storage = storage
+        self.compression_mode = compression_mode
+        self._deflate: Any = None
+        if compression_mode == "message":
+            from ._reader import _zstd
+
+            self._deflate = _zstd().compress
         self.topics: dict[str, TopicInfo] = {}
         self._files: list[dict[str, Any]] = []
         self._file: McapFile | Sqlite3File | None = None
@@ -114,6 +127,8 @@ class BagWriter:
             self._split()
             current = self._files[-1]
         self._sequence[topic] += 1
+        if self._deflate is not None:
+            data = self._deflate(data)
         assert self._file is not None
         self._file.write(topic, time_ns, data, self._sequence[topic])
         info.message_count += 1
@@ -137,7 +152,7 @@ class BagWriter:
         if self.closed:
             raise BagError(f"{self.directory}: checkpoint after close")
         self._split()
-        write_metadata(self.directory, self._files[:-1], list(self.topics.values()), storage=self.storage)
+        write_metadata(self.directory, self._files[:-1], list(self.topics.values()), **self._metadata_options())
 
     def close(self) -> None:
         """Finish the MCAP file (summary, footer) and write ``metadata.yaml``. Idempotent.
@@ -147,10 +162,12 @@ class BagWriter:
         if self.closed:
             return
         self.closed = True
-        self._close_file()
+        self._close_file(compress=False)
         if len(self._files) > 1 and self._files[-1]["message_count"] == 0:
             (self.directory / self._files.pop()["path"]).unlink()
-        write_metadata(self.directory, self._files, list(self.topics.values()), storage=self.storage)
+        else:
+            self._compress_file()
+        write_metadata(self.directory, self._files, list(self.topics.values()), **self._metadata_options())
 
     # -- files ------------------------------------------------------------------------
 
@@ -178,10 +195,30 @@ class BagWriter:
         assert self._file is not None
         self._file.register(topic, info, self._definitions[info.type])
 
-    def _close_file(self) -> None:
+    def _metadata_options(self) -> dict[str, str]:
+        return {"storage": self.storage, "compression_mode": self.compression_mode.upper()}
+
+    def _close_file(self, *, compress: bool = True) -> None:
         if self._file is not None:
-            self._file.close(metadata_text(self._files, list(self.topics.values()), storage=self.storage))
+            self._file.close(metadata_text(self._files, list(self.topics.values()), **self._metadata_options()))
             self._file = None
+            if compress:
+                self._compress_file()
+
+    def _compress_file(self) -> None:
+        """With ``compression_mode="file"``: the last (closed) storage file -> ``<file>.zstd``, as rosbag2."""
+        if self.compression_mode != "file":
+            return
+        import shutil
+
+        from ._reader import _zstd
+
+        entry = self._files[-1]
+        plain = self.directory / entry["path"]
+        with plain.open("rb") as src, _zstd().open(plain.with_name(plain.name + ".zstd"), "wb") as dst:
+            shutil.copyfileobj(src, dst)
+        plain.unlink()
+        entry["path"] = plain.name + ".zstd"
 
     def _split(self) -> None:
         self._close_file()

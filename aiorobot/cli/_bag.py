@@ -65,7 +65,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                      "~/snapshot (rosbag2_interfaces/srv/Snapshot) or a message on --snapshot-trigger")
     rec.add_argument("-s", "--storage", default="mcap", choices=("mcap", "sqlite3"), help="storage format (default mcap)")
     rec.add_argument("--compression-format", default="none", choices=("none", "zstd", "lz4"),
-                     help="MCAP chunk compression (default none, as rosbag2); readable by rosbags, mcap and ros2 bag")
+                     help="compression (default none, as rosbag2): alone, of the MCAP chunks (readable by rosbags, mcap "
+                     "and ros2 bag as they are); with --compression-mode, rosbag2's zstd per file or per message")
+    rec.add_argument("--compression-mode", default="", choices=("file", "message"), help="rosbag2's compression: zstd per file or per message")
     rec.add_argument("--snapshot-trigger", default="", metavar="TOPIC", help="with --snapshot-mode: any message on TOPIC takes a snapshot")
     _transport_args(rec)
 
@@ -145,8 +147,11 @@ def _record_problem(args: argparse.Namespace) -> str:
         return "--snapshot-mode keeps the last --max-cache-size MB in memory: give --max-cache-size"
     if args.snapshot_trigger and not args.snapshot_mode:
         return "--snapshot-trigger needs --snapshot-mode"
-    if args.storage == "sqlite3" and args.compression_format != "none":
-        return f"--compression-format {args.compression_format} is MCAP chunk compression; --storage sqlite3 is written uncompressed"
+    if args.compression_mode and args.compression_format != "zstd":
+        return f"--compression-mode {args.compression_mode} needs --compression-format zstd (rosbag2's only format)"
+    if args.storage == "sqlite3" and args.compression_format != "none" and not args.compression_mode:
+        return (f"--compression-format {args.compression_format} alone is MCAP chunk compression; with --storage sqlite3 "
+                "add --compression-mode file or message")
     return ""
 
 
@@ -242,7 +247,8 @@ async def _record(args: argparse.Namespace) -> int:
         "snapshot_mode": args.snapshot_mode,
         "snapshot_trigger": args.snapshot_trigger,
         "storage": args.storage,
-        "compression": args.compression_format,
+        "compression": "none" if args.compression_mode else args.compression_format,
+        "compression_mode": args.compression_mode,
     }
     if args.output:
         rec_kwargs["path"] = args.output

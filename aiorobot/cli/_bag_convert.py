@@ -57,7 +57,7 @@ def convert_main(args: argparse.Namespace) -> int:
         if not r.topics and not r.skipped:
             print(f"aiorobot bag convert: warning: {o.uri}: the output options select none of the input topics; "
                   f"the bag is empty", file=sys.stderr)
-        comp = "" if o.compression == "none" else f", {o.compression} chunks"
+        comp = f", zstd per {o.compression_mode}" if o.compression_mode else "" if o.compression == "none" else f", {o.compression} chunks"
         print(f"{o.uri}: {r.messages} messages on {len(r.topics)} topic(s) in {len(r.files)} {o.storage} file(s){comp}")
         for topic in r.skipped:
             print(f"aiorobot bag convert: warning: {o.uri}: {topic} skipped: its type is unknown and the bag holds no "

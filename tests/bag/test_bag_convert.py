@@ -119,6 +119,23 @@ def test_convert_splits_by_topic_and_merges_inputs_in_time_order(tmp_path: Path)
     assert _rosbags(tmp_path / "rest") == [m for m in written if m[0] != "/chatter"]
 
 
+@pytest.mark.parametrize(("storage", "mode"), [("mcap", "file"), ("sqlite3", "file"), ("mcap", "message"), ("sqlite3", "message")])
+def test_convert_with_rosbag2_file_and_message_compression_round_trips(tmp_path: Path, storage: str, mode: str) -> None:
+    written = _source(tmp_path / "src")
+    options = tmp_path / "out.yaml"
+    options.write_text(f"output_bags:\n- uri: {tmp_path / 'z'}\n  storage_id: {storage}\n  all_topics: true\n"
+                       f"  max_bagfile_size: 6000\n  compression_mode: {mode}\n  compression_format: zstd\n")
+    [result] = convert([tmp_path / "src"], read_output_options(options))
+    assert len(result.files) > 1
+    if mode == "file":
+        assert all(f.endswith(".zstd") for f in result.files) and not list((tmp_path / "z").glob("*.mcap"))
+    assert _rosbags(tmp_path / "z") == written  # rosbags decompresses as rosbag2 does
+    with BagReader(tmp_path / "z") as reader:
+        assert sorted(reader.messages()) == written
+    [back] = convert([tmp_path / "z"], [OutputBag(str(tmp_path / "plain"), all_topics=True)])
+    assert _rosbags(tmp_path / "plain") == written
+
+
 def test_topic_selection_follows_ros2_bag_record() -> None:
     out = OutputBag("x", all_topics=True, exclude_topics=("/b",), exclude_topic_types=("std_msgs/msg/Empty",))
     assert out.selects("/a", "std_msgs/msg/String") and not out.selects("/b", "std_msgs/msg/String")
@@ -133,12 +150,13 @@ def test_topic_selection_follows_ros2_bag_record() -> None:
     ("yaml", "message"),
     [
         ("output_bags:\n- uri: o\n  all_topic: true\n", r"output_bags\[0\]: unknown key 'all_topic'; did you mean 'all_topics'\?$"),
-        ("output_bags:\n- uri: o\n  compression_mode: file\n  compression_format: zstd\n",
-         r"output_bags\[0\].compression_mode: 'file' \(rosbag2's per-file zstd\) is not written by aiorobot"),
+        ("output_bags:\n- uri: o\n  compression_mode: file\n  compression_format: lz4\n",
+         r"output_bags\[0\].compression_format: compression_mode 'file' needs 'zstd' \(rosbag2's only format\), found 'lz4'$"),
         ("output_bags:\n- uri: o\n  storage_id: rosbag1\n", r"output_bags\[0\].storage_id: expected 'mcap' or 'sqlite3', found 'rosbag1'$"),
         ("output_bags:\n- storage_id: mcap\n", r"output_bags\[0\].uri: required"),
         ("bags: []\n", r"expected a non-empty list under the top-level key 'output_bags'"),
-        ("output_bags:\n- uri: o\n  storage_id: sqlite3\n  compression_format: zstd\n", r"storage_id sqlite3 is written uncompressed$"),
+        ("output_bags:\n- uri: o\n  storage_id: sqlite3\n  compression_format: zstd\n",
+         r"zstd without compression_mode is MCAP chunk compression; for storage_id sqlite3 use compression_mode: file or message$"),
     ],
 )
 def test_bad_output_options_are_one_error_naming_file_and_key(tmp_path: Path, yaml: str, message: str) -> None:
