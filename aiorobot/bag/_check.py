@@ -49,6 +49,8 @@ class CheckResult:
         )
         if r.not_in_bag:
             lines.append(f"not in the bag, so never received: {', '.join(r.not_in_bag)}")
+        if r.not_recorded:
+            lines.append(f"published but not in the bag, so not compared: {', '.join(r.not_recorded)}")
         rows = [("topic", "recorded", "replayed", "differing", "first difference")]
         for t in self.diff.topics:
             first = "-"

@@ -36,6 +36,7 @@ class ReplayResult:
 
     ``outputs``: topic -> ``[(time_ns, cdr), ...]`` as the nodes published them; ``inputs``: the
     topics played; ``not_in_bag``: topics the nodes subscribe to that the bag lacks;
+    ``not_recorded``: topics the nodes publish that the bag lacks (so nothing to compare with);
     ``played``: input messages published; ``steps``: times ``/clock`` moved; ``sim_ns``: the
     recording time replayed.
     """
@@ -47,6 +48,7 @@ class ReplayResult:
     steps: int
     sim_ns: int
     types: dict[str, Any] = field(default_factory=dict)
+    not_recorded: tuple[str, ...] = ()
 
 
 async def replay(
@@ -142,7 +144,8 @@ async def replay(
                 await step_to(end_ns)
                 await rt.settle(rounds=settle_rounds)
     not_in_bag = tuple(sorted(t for t in subscribed if t not in known and t != "/clock"))
-    return ReplayResult(captured, inputs, not_in_bag, played, steps, now_ns - reader.start_ns, types)
+    not_recorded = tuple(sorted(t for t in published if t not in known and t not in INFRASTRUCTURE_TOPICS))
+    return ReplayResult(captured, inputs, not_in_bag, played, steps, now_ns - reader.start_ns, types, not_recorded)
 
 
 def _outputs(path: str, known: dict[str, Any], published: dict[str, Any], outputs: Sequence[str] | None) -> list[str]:

@@ -44,6 +44,7 @@ async def test_unchanged_node_matches_the_recording_exactly(ekf_run: Path) -> No
     assert result.passed, result.table()
     assert result.replay.inputs == ("/imu/data", "/odom", "/tf_static")
     assert result.replay.not_in_bag == ("/set_pose",)
+    assert result.replay.not_recorded == ()
     counts = {t.topic: (t.recorded, t.replayed, t.differing) for t in result.diff.topics}
     filtered = len(_recorded(ekf_run, "/odometry/filtered"))
     assert filtered > 100 and counts["/odometry/filtered"] == (filtered, filtered, 0)
@@ -83,6 +84,13 @@ async def test_a_tolerance_covering_the_change_passes(ekf_run: Path) -> None:
     assert result.passed, result.table()
     assert result.diff.topics[1].max_error["pose.covariance[0]"] > 0  # reported, within tolerance
     assert "(1)" in result.table()
+
+
+async def test_outputs_the_bag_lacks_are_named_not_dropped_silently(ekf_run: Path) -> None:
+    renamed = {**EKF, "publish_tf": False}
+    result = await check_bag(str(ekf_run), [functools.partial(EkfNode, parameter_overrides=renamed, remappings={"odometry/filtered": "/odom_new"})])
+    assert result.replay.not_recorded == ("/odom_new",)
+    assert "published but not in the bag, so not compared: /odom_new" in result.table()
 
 
 async def test_nodes_that_take_nothing_from_the_bag_are_one_clear_error(ekf_run: Path) -> None:
