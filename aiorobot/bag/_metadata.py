@@ -9,7 +9,7 @@ from typing import Any
 
 from .._core._qos import DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile, ReliabilityPolicy
 
-__all__ = ["BagError", "TopicInfo", "qos_from_bag", "qos_to_bag", "write_metadata"]
+__all__ = ["BagError", "TopicInfo", "metadata_text", "qos_from_bag", "qos_profiles_yaml", "qos_to_bag", "write_metadata"]
 
 METADATA = "metadata.yaml"
 VERSION = 9
@@ -75,9 +75,14 @@ def qos_from_bag(profiles: list[Any]) -> QoSProfile:
 
 def qos_yaml(qos: QoSProfile) -> str:
     """The YAML text rosbag2's MCAP storage keeps in a channel's ``offered_qos_profiles``."""
+    return qos_profiles_yaml([qos_to_bag(qos)])
+
+
+def qos_profiles_yaml(profiles: list[Any]) -> str:
+    """rosbags ``Qos`` profiles (as a bag holds them, every field kept) as ``offered_qos_profiles`` YAML."""
     from rosbags.rosbag2.metadata import dump_qos_v9
 
-    return _yaml_text(dump_qos_v9([qos_to_bag(qos)]))
+    return _yaml_text(dump_qos_v9(profiles))
 
 
 def _yaml_text(data: Any) -> str:
@@ -96,10 +101,21 @@ def write_metadata(
     topics: list[TopicInfo],
     *,
     storage: str = "mcap",
+    compression_mode: str = "",
 ) -> None:
     """Write ``directory/metadata.yaml`` in rosbag2's version 9 format (atomically: temp file + rename).
 
     ``files``: one dict per storage file, ``{"path", "start_ns", "duration_ns", "message_count"}``.
+    """
+    tmp = directory / (METADATA + ".tmp")
+    tmp.write_text(metadata_text(files, topics, storage=storage, compression_mode=compression_mode), encoding="utf8")
+    tmp.replace(directory / METADATA)
+
+
+def metadata_text(files: list[dict[str, Any]], topics: list[TopicInfo], *, storage: str = "mcap", compression_mode: str = "") -> str:
+    """The ``metadata.yaml`` text (version 9) of a bag made of ``files`` holding ``topics``.
+
+    ``compression_mode``: rosbag2's ``FILE`` or ``MESSAGE`` zstd compression, ``""`` for none.
     """
     from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 
@@ -126,8 +142,8 @@ def write_metadata(
                 }
                 for t in topics
             ],
-            "compression_format": "",
-            "compression_mode": "",
+            "compression_format": "zstd" if compression_mode else "",
+            "compression_mode": compression_mode,
             "files": [
                 {
                     "path": f["path"],
@@ -141,6 +157,4 @@ def write_metadata(
             "ros_distro": "jazzy",
         }
     }
-    tmp = directory / (METADATA + ".tmp")
-    tmp.write_text(_yaml_text(doc), encoding="utf8")
-    tmp.replace(directory / METADATA)
+    return _yaml_text(doc)

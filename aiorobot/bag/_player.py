@@ -28,8 +28,8 @@ __all__ = ["Player", "PlayerStatistics", "parse_remaps"]
 
 #: The longest the player publishes due messages back to back before giving the loop a turn.
 _YIELD_NS = 2_000_000
-#: the longest the player sleeps before it looks at a new rate or a seek again
-_CONTROL_NS = 50_000_000
+#: The longest the player sleeps before looking again at its state (a seek, a stop, a rate change).
+_POLL_NS = 50_000_000
 
 
 def parse_remaps(remaps: list[str]) -> dict[str, str]:
@@ -60,6 +60,24 @@ class PlayerStatistics:
     topics_matched: int = 0
 
 
+class _Cursor:
+    """The next message to play, in time order; ``seek`` starts again from a time."""
+
+    def __init__(self, reader: BagReader, topics: list[str], start_ns: int) -> None:
+        self._reader, self._topics = reader, topics
+        self.seek(start_ns)
+
+    def seek(self, start_ns: int) -> None:
+        self._messages = self._reader.messages(self._topics, start_ns=start_ns)
+        self._next: tuple[str, int, bytes] | None = next(self._messages, None)
+
+    def peek(self) -> tuple[str, int, bytes] | None:
+        return self._next
+
+    def pop(self) -> None:
+        self._next = next(self._messages, None)
+
+
 class Player(Node):
     """A node that plays a rosbag2 directory.
 
@@ -67,6 +85,10 @@ class Player(Node):
     (publish ``/clock``), ``clock_hz`` (its rate between messages, default 40 as ``ros2 bag
     play --clock``), ``loop``, ``start_offset`` (seconds into the bag), ``topics`` (only these),
     ``remap`` (``["/from:=/to", ...]``), ``start_paused``.
+
+    rosbag2's player services (``~/pause`` ... ``~/stop``, see :mod:`._control`) call the
+    methods of the same names; a seek, a rate change or a resume re-anchors the pacing at the
+    current bag time, so playback goes on from there.
     """
 
     def __init__(
@@ -135,12 +157,16 @@ class Player(Node):
         self._resume = asyncio.Event()
         if not start_paused:
             self._resume.set()
-        self._kick = asyncio.Event()  # a resume or a seek wakes a paused playback
-        self._seek_to: int | None = None
-        self._wall0 = time.monotonic_ns()
-        self._base = self._playhead = self.reader.start_ns + int(self.start_offset * 1e9)
         self._done = asyncio.Event()
         self._task: asyncio.Task[None] | None = None
+        self._stopped = False
+        start_ns = self.reader.start_ns + int(self.start_offset * 1e9)
+        self._cursor = _Cursor(self.reader, list(self._types), start_ns)
+        self._paused_bag_ns = start_ns
+        self._anchor(start_ns)
+        from ._control import create_player_services
+
+        create_player_services(self)
 
     def __repr__(self) -> str:
         return f"<Player {self.path} rate={self.rate:g} published={self._published}>"
@@ -177,15 +203,17 @@ class Player(Node):
             response.type_description = type_description(msg_type)
         return response
 
-    # -- control ------------------------------------------------------------------------
+    # -- control (rosbag2's Player API; ``_control`` serves it as rosbag2_interfaces services) ----
 
     def pause(self) -> None:
-        self._playhead = self.current_time_ns
-        self._resume.clear()
+        if self._resume.is_set():
+            self._paused_bag_ns = self._bag_now()
+            self._resume.clear()
 
     def resume(self) -> None:
-        self._resume.set()
-        self._kick.set()
+        if not self._resume.is_set():
+            self._anchor(self._paused_bag_ns)
+            self._resume.set()
 
     def toggle_pause(self) -> bool:
         """Pause if playing, resume if paused; returns True when now paused."""
@@ -195,28 +223,58 @@ class Player(Node):
         self.resume()
         return False
 
+    def is_paused(self) -> bool:
+        return not self._resume.is_set()
+
+    def get_rate(self) -> float:
+        return self.rate
+
     def set_rate(self, rate: float) -> None:
         if not rate > 0:
             raise ValueError(f"rate must be > 0, found {rate!r}")
-        self.rate = float(rate)  # the playback rebases at the current position: no jump
+        self._anchor(self._bag_now())  # playback goes on from where it is, at the new speed
+        self.rate = float(rate)
 
-    def seek(self, t_ns: int) -> None:
-        """Go on from bag time ``t_ns`` (clamped to the bag's start and end); paused stays paused.
-        After the end, a seek plays again from there (once resumed, if paused)."""
-        self._seek_to = min(max(int(t_ns), self.reader.start_ns), self.reader.end_ns)
-        self._playhead = self._seek_to
-        self._kick.set()
-        if self._done.is_set() and self._task is not None:
+    def seek(self, time_ns: int) -> None:
+        """Go on from the first message at or after ``time_ns`` (bag time, clamped to the bag's
+        start and end); paused stays paused. After the end, playback starts again from there."""
+        time_ns = min(max(int(time_ns), self.reader.start_ns), self.reader.end_ns)
+        self._cursor.seek(time_ns)
+        self._paused_bag_ns = time_ns
+        self._anchor(time_ns)
+        if self._done.is_set() and not self._stopped and self._task is not None:
             self._done.clear()
-            self._task = self.create_task(self._play(), name=f"aiorobot-player {self.path}")
+            self._task = self.create_task(self._play(from_seek=True), name=f"aiorobot-player {self.path}")
 
     @property
     def current_time_ns(self) -> int:
-        """The bag time playback has reached (the recorded time of what plays next, while paused)."""
-        if not self._resume.is_set() or self.done or self._seek_to is not None:
-            return self._playhead
-        elapsed = int((time.monotonic_ns() - self._wall0) * self.rate)
-        return min(max(self._base + elapsed, self._playhead), self.reader.end_ns)
+        """The bag time playback has reached (while paused: the time it goes on from)."""
+        return min(self._bag_now(), self.reader.end_ns)
+
+    def play_next(self) -> bool:
+        """While paused, publish the next message at once; False when playing, stopped or at the end (as rosbag2)."""
+        if self._resume.is_set() or self._stopped:
+            return False
+        item = self._cursor.peek()
+        if item is None:
+            return False
+        self._cursor.pop()
+        self._paused_bag_ns = item[1]
+        return self._publish_recorded(*item)
+
+    def burst(self, num_messages: int) -> int:
+        """While paused, publish up to ``num_messages`` (0: all the rest) at once; returns how many were."""
+        count = 0
+        while num_messages <= 0 or count < num_messages:
+            if not self.play_next():
+                break
+            count += 1
+        return count
+
+    def stop(self) -> None:
+        """End playback (the player stays in the graph; ``done`` becomes true)."""
+        self._stopped = True
+        self._resume.set()
 
     @property
     def done(self) -> bool:
@@ -240,81 +298,79 @@ class Player(Node):
             self._task.cancel()
         self.reader.close()
 
-    async def _play(self) -> None:
-        from aiorobot.msgs import deserialize
+    def _anchor(self, bag_ns: int) -> None:
+        """From now on, bag time ``bag_ns`` is played at this wall instant, advancing at ``rate``."""
+        self._anchor_wall_ns, self._anchor_bag_ns = time.monotonic_ns(), bag_ns
 
-        origin = start = self.reader.start_ns + int(self.start_offset * 1e9)
-        if self._seek_to is not None:  # a seek after the end starts this pass
-            start, self._seek_to = self._seek_to, None
+    def _bag_now(self) -> int:
+        if not self._resume.is_set():
+            return self._paused_bag_ns
+        return self._anchor_bag_ns + int((time.monotonic_ns() - self._anchor_wall_ns) * self.rate)
+
+    async def _play(self, from_seek: bool = False) -> None:
+        """Play the bag (``loop``: again and again); ``from_seek``: a seek after the end started
+        this pass, which goes on from the sought time rather than the start."""
+        start = self.reader.start_ns + int(self.start_offset * 1e9)
         clock_period_ns = int(1e9 / self.clock_hz)
         turn = time.monotonic_ns()  # when the loop last had a turn
         try:
-            while True:
-                wall_t0 = self._wall0 = time.monotonic_ns()
-                base = self._base = start  # bag time played at wall_t0
-                rate = self.rate
-                last_clock = wall_t0 - clock_period_ns
+            while not self._stopped:
+                if self._loops and not from_seek:
+                    self.seek(start)
+                else:  # the bag time set at construction or by a seek since, played from now on
+                    self._anchor(self._paused_bag_ns)
+                from_seek = False
+                last_clock = time.monotonic_ns() - clock_period_ns
                 played = self._published + self._skipped
-                seek: int | None = None
-                for topic, t_ns, data in self.reader.messages(list(self._types), start_ns=start):
-                    while True:  # pace: wait for the message's time, publishing /clock meanwhile
-                        while not self._resume.is_set() and self._seek_to is None:
-                            paused_at = time.monotonic_ns()
-                            self._kick.clear()
-                            await self._kick.wait()
-                            wall_t0 = self._wall0 = wall_t0 + time.monotonic_ns() - paused_at
-                        if self._seek_to is not None:
-                            seek, self._seek_to = self._seek_to, None
-                            break
-                        now = time.monotonic_ns()
-                        if self.rate != rate:  # rebase at the current position: a new rate does not jump
-                            base = self._base = base + int((now - wall_t0) * rate)
-                            wall_t0 = self._wall0 = now
-                            rate = self.rate
-                        due = wall_t0 + int((t_ns - base) / rate)
-                        if now >= due:
-                            if now - turn >= _YIELD_NS:  # behind schedule: still let the loop run
-                                await asyncio.sleep(0)
-                                turn = time.monotonic_ns()
-                            break
-                        wake = due
+                while not self._stopped and (item := self._cursor.peek()) is not None:
+                    if not self._resume.is_set():
+                        await self._resume.wait()
+                        continue  # a play_next, seek or stop may have come meanwhile
+                    now = time.monotonic_ns()
+                    due = self._anchor_wall_ns + int((item[1] - self._anchor_bag_ns) / self.rate)
+                    if now < due:  # pace: wait for the message's time, publishing /clock meanwhile
+                        wake = min(due, now + _POLL_NS)
                         if self._clock_pub is not None:
                             if now - last_clock >= clock_period_ns:
-                                self._publish_clock(base + int((now - wall_t0) * rate))
+                                self._publish_clock(self._bag_now())
                                 last_clock = now
-                            wake = min(due, last_clock + clock_period_ns)
-                        await self._sleep_until_ns(min(wake, now + _CONTROL_NS))
+                            wake = min(wake, last_clock + clock_period_ns)
+                        await self._sleep_until_ns(wake)
                         turn = time.monotonic_ns()
-                    if seek is not None:
-                        break
-                    self._playhead = t_ns
-                    if self._clock_pub is not None:
-                        self._publish_clock(t_ns)
-                    try:
-                        msg = deserialize(data, self._types[topic])
-                    except Exception as err:  # a damaged record: skip it, say so, keep playing
-                        self._skipped += 1
-                        self.get_logger().warning(
-                            f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0
-                        )
                         continue
-                    pub = self._topic_pubs[topic]
-                    pub.publish(msg)
-                    self._published += 1
-                    matched = pub.get_subscription_count()
-                    if matched > self._matched.get(topic, 0):
-                        self._matched[topic] = matched
-                if seek is not None:
-                    start = seek
-                    continue
+                    if now - turn >= _YIELD_NS:  # behind schedule: still let the loop run
+                        await asyncio.sleep(0)
+                        turn = time.monotonic_ns()
+                        continue
+                    self._cursor.pop()
+                    self._publish_recorded(*item)
                 self._loops += 1
                 if not self.loop or self._published + self._skipped == played:  # nothing to play again
                     break
-                start = origin
                 await asyncio.sleep(0)  # a pass may have taken no time at all: the loop gets a turn
                 turn = time.monotonic_ns()
         finally:
             self._done.set()
+
+    def _publish_recorded(self, topic: str, t_ns: int, data: bytes) -> bool:
+        """Publish one recorded message (``/clock`` first, at its time, with ``clock``); False if it does not decode."""
+        from aiorobot.msgs import deserialize
+
+        if self._clock_pub is not None:
+            self._publish_clock(t_ns)
+        try:
+            msg = deserialize(data, self._types[topic])
+        except Exception as err:  # a damaged record: skip it, say so, keep playing
+            self._skipped += 1
+            self.get_logger().warning(f"{topic}: a message at {t_ns} ns does not decode ({err}); skipped", throttle_duration_sec=1.0)
+            return False
+        pub = self._topic_pubs[topic]
+        pub.publish(msg)
+        self._published += 1
+        matched = pub.get_subscription_count()
+        if matched > self._matched.get(topic, 0):
+            self._matched[topic] = matched
+        return True
 
     async def _sleep_until_ns(self, deadline_ns: int) -> None:
         """Sleep to a monotonic deadline with the loop's precise waker (libuv timers are whole ms)."""

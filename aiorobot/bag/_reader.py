@@ -18,7 +18,7 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
-from ._metadata import METADATA, BagError, TopicInfo, qos_from_bag
+from ._metadata import METADATA, BagError, TopicInfo, qos_from_bag, qos_profiles_yaml
 from ._types import resolve_type
 
 __all__ = ["BagReader"]
@@ -132,12 +132,13 @@ class BagReader:
                 type_name = first.msgtype or meta_type
                 defined = next((c for c in conns if c.msgdef.format != MessageDefinitionFormat.NONE), None)
                 self._definitions[name] = None if defined is None else (defined.msgdef.format.name, defined.msgdef.data)
-                qos = qos_from_bag(list(getattr(first.ext, "offered_qos_profiles", []) or []))
+                profiles = list(getattr(first.ext, "offered_qos_profiles", []) or [])
+                qos, qos_text = qos_from_bag(profiles), qos_profiles_yaml(profiles) if profiles else ""
                 digest = first.digest
             else:
-                type_name, digest, qos = meta_type, "", qos_from_bag([])
+                type_name, digest, qos, qos_text = meta_type, "", qos_from_bag([]), ""
                 self._definitions[name] = None
-            self.topics.append(TopicInfo(name, type_name, digest, qos, count))
+            self.topics.append(TopicInfo(name, type_name, digest, qos, count, qos_text=qos_text))
             if count < meta_count:
                 reason = (
                     "no storage file holds the topic"

@@ -24,11 +24,16 @@ from .._core._pubsub import Endpoint, Publisher
 from .._core._qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ..lowlevel import Tap, add_tap, remove_tap, watch_publishers
 from ._metadata import BagError
+from ._snapshot import SnapshotBuffer
 from ._writer import CHUNK_SIZE, BagWriter
 
 __all__ = ["Recorder", "RecorderStatistics", "default_bag_name"]
 
 _STOP = object()
+_SPLIT = object()
+_SNAPSHOT = object()
+#: How often (wall seconds) ``snapshot_on_failure`` looks at the runtime's failure counts.
+_FAILURE_POLL_SEC = 0.2
 #: How long the writer thread lets messages gather between batches.
 _BATCH_SEC = 0.005
 
@@ -46,6 +51,8 @@ class RecorderStatistics:
     messages: int
     bytes: int
     queued: int
+    #: snapshots written (snapshot mode)
+    snapshots: int = 0
 
 
 class Recorder(Node):
@@ -57,7 +64,19 @@ class Recorder(Node):
     record with ``all``), ``max_bag_size`` (bytes per file, 0 = no split),
     ``max_bag_duration`` (seconds per file, 0 = no split), ``max_cache_size`` (bytes of messages
     held before a chunk goes to the file: what a crash can lose; default 256 KiB), ``compression``
-    (``none`` as rosbag2's default, ``zstd`` or ``lz4`` per chunk).
+    (``none`` as rosbag2's default, ``zstd`` or ``lz4`` per chunk), ``storage`` (``mcap``, or
+    ``sqlite3`` for ``.db3`` files), ``compression_mode`` (rosbag2's zstd per ``file`` or per
+    ``message``, either storage; ``compression`` then stays ``none``).
+
+    Snapshot mode (``snapshot_mode``, rosbag2's flight recorder): nothing is written while
+    recording; the last ``max_cache_size`` bytes of messages (required > 0 here) are kept in a
+    :class:`SnapshotBuffer`, and :meth:`snapshot` (the ``~/snapshot`` service, or any message on
+    the ``snapshot_trigger`` topic, or with ``snapshot_on_failure`` a callback failure, a failed
+    start or a loop stall in this recorder's runtime) writes them. Each snapshot ends its storage file and rewrites
+    ``metadata.yaml``, so the directory is a complete, readable bag as soon as it is written.
+
+    rosbag2's recorder services (``~/pause``, ``~/resume``, ``~/is_paused``, ``~/split_bagfile``)
+    call :meth:`pause`, :meth:`resume`, :meth:`is_paused` and :meth:`split_bagfile`.
     """
 
     def __init__(
@@ -72,6 +91,11 @@ class Recorder(Node):
         max_bag_duration: float = 0.0,
         max_cache_size: int = 0,
         compression: str = "none",
+        snapshot_mode: bool = False,
+        snapshot_trigger: str = "",
+        snapshot_on_failure: bool = False,
+        storage: str = "mcap",
+        compression_mode: str = "",
         **kwargs: Any,
     ) -> None:
         super().__init__(node_name, **kwargs)
@@ -87,10 +111,36 @@ class Recorder(Node):
         self._compression = str(self.declare_parameter("compression", compression).value)
         if self._compression not in ("none", "zstd", "lz4"):
             raise ValueError(f"recorder {self.get_name()}: compression must be 'none', 'zstd' or 'lz4', found {self._compression!r}")
+        self._storage = str(self.declare_parameter("storage", storage).value)
+        if self._storage not in ("mcap", "sqlite3"):
+            raise ValueError(f"recorder {self.get_name()}: storage must be 'mcap' or 'sqlite3', found {self._storage!r}")
+        self._compression_mode = str(self.declare_parameter("compression_mode", compression_mode).value)
+        if self._compression_mode not in ("", "file", "message"):
+            raise ValueError(f"recorder {self.get_name()}: compression_mode must be '', 'file' or 'message', found {self._compression_mode!r}")
+        if self._compression_mode and self._compression != "none":
+            raise ValueError(f"recorder {self.get_name()}: compression_mode {self._compression_mode!r} compresses with zstd "
+                             f"already; leave compression at 'none'")
+        if self._storage == "sqlite3" and self._compression != "none":
+            raise ValueError(f"recorder {self.get_name()}: compression {self._compression!r} is MCAP chunk compression; "
+                             "sqlite3 storage is written uncompressed")
         if self._max_size < 0 or self._max_duration < 0 or self._cache < 0:
             raise ValueError(
                 f"recorder {self.get_name()}: max_bag_size, max_bag_duration and max_cache_size must be >= 0"
             )
+        self.snapshot_mode = bool(self.declare_parameter("snapshot_mode", snapshot_mode).value)
+        self._trigger = str(self.declare_parameter("snapshot_trigger", snapshot_trigger).value)
+        self._on_failure = bool(self.declare_parameter("snapshot_on_failure", snapshot_on_failure).value)
+        self._ring: SnapshotBuffer | None = None
+        if self.snapshot_mode:
+            if self._cache <= 0:
+                raise ValueError(
+                    f"recorder {self.get_name()}: snapshot_mode keeps the last max_cache_size bytes in memory, "
+                    f"so max_cache_size must be > 0, found {self._cache}"
+                )
+            self._ring = SnapshotBuffer(self._cache)
+        elif self._trigger or self._on_failure:
+            what = f"snapshot_trigger {self._trigger!r}" if self._trigger else "snapshot_on_failure"
+            raise ValueError(f"recorder {self.get_name()}: {what} needs snapshot_mode")
         if Path(self.path).exists():
             raise BagError(f"{self.path}: exists already; choose another output directory or remove it")
         self._taps: dict[str, Tap] = {}
@@ -102,12 +152,18 @@ class Recorder(Node):
         self._error: BaseException | None = None
         self._bytes = 0
         self._count = 0
+        self._paused = False
+        self._snapshots = 0
+        self._trigger_tap: Tap | None = None
+        from ._control import create_recorder_services
+
+        create_recorder_services(self, snapshot=self.snapshot_mode)
 
     def __repr__(self) -> str:
         return f"<Recorder {self.path} topics={len(self._taps)} messages={self._count}>"
 
     def statistics(self) -> RecorderStatistics:
-        return RecorderStatistics(len(self._taps), self._count, self._bytes, self._queue.qsize())
+        return RecorderStatistics(len(self._taps), self._count, self._bytes, self._queue.qsize(), self._snapshots)
 
     @property
     def recorded_topics(self) -> list[str]:
@@ -126,8 +182,10 @@ class Recorder(Node):
             self.path,
             max_bag_size=self._max_size,
             max_bag_duration_ns=int(self._max_duration * 1e9),
-            chunk_size=self._cache or CHUNK_SIZE,
+            chunk_size=CHUNK_SIZE if self.snapshot_mode else self._cache or CHUNK_SIZE,
             compression=self._compression,
+            storage=self._storage,
+            compression_mode=self._compression_mode,
         )
         self._thread = threading.Thread(target=self._write_loop, name=f"aiorobot-recorder {self.path}", daemon=True)
         self._thread.start()
@@ -135,9 +193,16 @@ class Recorder(Node):
             self._unwatch = watch_publishers(self.runtime, self._on_endpoint)
         for name in self.topics:
             self._tap_requested(name)
+        if self._trigger:
+            self._on_first_publisher(self._trigger, self._add_trigger)
+        mode = f" in snapshot mode (the last {self._cache} bytes, written on ~/snapshot)" if self.snapshot_mode else ""
         self.get_logger().info(
-            f"recording {'all topics' if self.all_topics else ', '.join(self.topics)} to {self.path}"
+            f"recording {'all topics' if self.all_topics else ', '.join(self.topics)} to {self.path}{mode}"
         )
+
+    async def on_start(self) -> None:
+        if self._on_failure:
+            self.create_task(self._watch_failures(), name=f"aiorobot-recorder {self.path} failure trigger")
 
     async def on_shutdown(self) -> None:
         self.stop()
@@ -150,6 +215,9 @@ class Recorder(Node):
         if self.executor is not None:
             with self._lock:
                 taps, self._taps = list(self._taps.values()), {}
+                if self._trigger_tap is not None:
+                    taps.append(self._trigger_tap)
+                    self._trigger_tap = None
             for tap in taps:
                 remove_tap(self.runtime, tap)
         if self._thread is not None:
@@ -158,6 +226,63 @@ class Recorder(Node):
             self._thread = None
         if self._error is not None:
             raise BagError(f"recorder {self.get_name()}: writing {self.path} failed: {self._error}")
+
+    # -- control (rosbag2's Recorder API; ``_control`` serves it as rosbag2_interfaces services) ----
+
+    def pause(self) -> None:
+        """Stop writing messages (they are dropped) until :meth:`resume`; the topics stay tapped."""
+        self._paused = True
+
+    def resume(self) -> None:
+        self._paused = False
+
+    def is_paused(self) -> bool:
+        return self._paused
+
+    def split_bagfile(self) -> None:
+        """Go on in a new storage file, after every message received so far."""
+        self._queue.put(_SPLIT)
+
+    def snapshot(self) -> bool:
+        """Write what the snapshot buffer holds (snapshot mode; False otherwise, as rosbag2's ``take_snapshot``).
+
+        The writer thread appends the messages, ends the file and rewrites ``metadata.yaml``;
+        ``statistics().snapshots`` counts the snapshots written.
+        """
+        if self._ring is None:
+            self.get_logger().warning("snapshot requested, but the recorder is not in snapshot mode")
+            return False
+        self._queue.put((_SNAPSHOT, self._ring.take()))
+        return True
+
+    async def _watch_failures(self) -> None:
+        """Take a snapshot whenever the runtime counts a new failure, failed start or stall (checked
+        every ``_FAILURE_POLL_SEC`` of wall time, so a stall is caught as soon as the loop runs again)."""
+        import asyncio
+
+        def trouble() -> int:
+            stats = self.runtime.statistics()
+            return sum(stats["failures"].values()) + len(stats["failed_starts"]) + sum(stats["stalls"].values())
+
+        seen = trouble()
+        while True:
+            await asyncio.sleep(_FAILURE_POLL_SEC)
+            now = trouble()
+            if now > seen:
+                self.get_logger().warning(f"the runtime counted {now - seen} new failure(s) or stall(s): taking a snapshot")
+                self.snapshot()
+            seen = now
+
+    def _add_trigger(self, pub: Publisher[Any]) -> None:
+        """Any message on the trigger topic takes a snapshot (in the publishing thread: the buffer and the queue are thread-safe)."""
+        qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
+        tap = Tap(pub.msg_type, pub.topic_name, qos, lambda _msg: self.snapshot(), owner=self.get_fully_qualified_name())
+        tap.node, tap.wants_remote = self, True
+        with self._lock:
+            if self._thread is None:
+                return
+            self._trigger_tap = tap
+        add_tap(self.runtime, tap)
 
     # -- taps -------------------------------------------------------------------------
 
@@ -170,6 +295,10 @@ class Recorder(Node):
 
     def _tap_requested(self, name: str) -> None:
         """Tap ``name`` now if it has a publisher, else as soon as one appears."""
+        self._on_first_publisher(name, lambda pub: self._add_tap(pub.topic_name, pub.msg_type, pub.qos))
+
+    def _on_first_publisher(self, name: str, callback: Any) -> None:
+        """``callback(publisher)`` for the first publisher of ``name``: now if there is one, else when it appears."""
         name = self.resolve_topic_name(name)
         found = False
         unwatch = None
@@ -178,7 +307,7 @@ class Recorder(Node):
             nonlocal found
             if pub.topic_name == name and not found:
                 found = True
-                self._add_tap(name, pub.msg_type, pub.qos)
+                callback(pub)
                 if unwatch is not None:
                     unwatch()
 
@@ -200,9 +329,15 @@ class Recorder(Node):
             self._queue.put(("topic", name, type_name, offered))
             clock = self.runtime.clock
             put = self._queue.put
+            ring = self._ring
 
             def record(msg: Any) -> None:
-                put((name, clock.now().nanoseconds, serialize(msg)))
+                if self._paused:
+                    return
+                if ring is not None:
+                    ring.push(name, clock.now().nanoseconds, serialize(msg))
+                else:
+                    put((name, clock.now().nanoseconds, serialize(msg)))
 
             tap = Tap(msg_type, name, qos, record, owner=self.get_fully_qualified_name())
             tap.node, tap.wants_remote = self, True  # also receives remote publishers over a transport
@@ -225,7 +360,16 @@ class Recorder(Node):
                 while True:
                     if item is _STOP:
                         return
-                    if item[0] == "topic":
+                    if item is _SPLIT:
+                        writer.split()
+                    elif item[0] is _SNAPSHOT:
+                        for topic, time_ns, data in item[1]:
+                            writer.write(topic, time_ns, data)
+                            self._count += 1
+                            self._bytes += len(data)
+                        writer.checkpoint()
+                        self._snapshots += 1
+                    elif item[0] == "topic":
                         _, name, type_name, qos = item
                         writer.add_topic(name, type_name, qos)
                     else:

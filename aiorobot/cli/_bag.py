@@ -1,8 +1,10 @@
-"""``aiorobot bag record|play|info|reindex``: ``ros2 bag`` for aiorobot graphs.
+"""``aiorobot bag record|play|info|reindex|check|convert|sweep``: ``ros2 bag`` for aiorobot graphs.
 
 ``record`` and ``play`` join the running graph through a transport (``--transport``, zenoh by
 default: other processes are only reachable over the network); ``info`` and ``reindex`` work
-on the directory alone.
+on the directory alone; ``check`` (``_bag_check``) replays a bag into nodes in this process;
+``convert`` (``_bag_convert``) rewrites bags as a rosbag2 output-options file says; ``sweep``
+(``_bag_sweep``) replays a bag into parameter variants in worker processes.
 """
 
 from __future__ import annotations
@@ -56,6 +58,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     rec.add_argument("--max-duration", type=positive_seconds, metavar="S", help="start a new file every S seconds (ros2's --max-bag-duration)")
     rec.add_argument("--max-size", type=_positive_float, metavar="MB", help="start a new file every MB megabytes (ros2's --max-bag-size)")
     rec.add_argument("--duration", type=positive_seconds, metavar="S", help="stop recording after S seconds (default: until Ctrl-C)")
+    rec.add_argument("--max-cache-size", type=_positive_float, metavar="MB",
+                     help="megabytes held in memory before they go to the file; with --snapshot-mode, the ring buffer's size")
+    rec.add_argument("--snapshot-mode", action="store_true",
+                     help="flight recorder: keep the last --max-cache-size MB in memory and write them only on "
+                     "~/snapshot (rosbag2_interfaces/srv/Snapshot) or a message on --snapshot-trigger")
+    rec.add_argument("-s", "--storage", default="mcap", choices=("mcap", "sqlite3"), help="storage format (default mcap)")
+    rec.add_argument("--compression-format", default="none", choices=("none", "zstd", "lz4"),
+                     help="compression (default none, as rosbag2): alone, of the MCAP chunks (readable by rosbags, mcap "
+                     "and ros2 bag as they are); with --compression-mode, rosbag2's zstd per file or per message")
+    rec.add_argument("--compression-mode", default="", choices=("file", "message"), help="rosbag2's compression: zstd per file or per message")
+    rec.add_argument("--snapshot-trigger", default="", metavar="TOPIC", help="with --snapshot-mode: any message on TOPIC takes a snapshot")
     _transport_args(rec)
 
     play = sub.add_parser("play", help="play a bag into the running graph", description="Play a rosbag2 directory (ros2 bag play).")
@@ -81,6 +94,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                            description="Rebuild the MCAP files and metadata.yaml of a bag whose recorder died (SIGKILL, power loss).")
     reidx.add_argument("bag", type=Path, metavar="DIR")
 
+    from ._bag_check import add_check_arguments
+    from ._bag_convert import add_convert_arguments
+    from ._bag_sweep import add_sweep_arguments
+
+    add_check_arguments(sub)
+    add_convert_arguments(sub)
+    add_sweep_arguments(sub)
+
 
 def _transport_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--transport", default="zenoh", type=transport_name, metavar="NAME",
@@ -93,8 +114,23 @@ def main(args: argparse.Namespace) -> int:
 
     verb = args.bag_command
     if verb is None:
-        print("aiorobot bag: error: expected a verb (record, play, info, reindex)", file=sys.stderr)
+        print("aiorobot bag: error: expected a verb (record, play, info, reindex, check, convert, sweep)", file=sys.stderr)
         return 2
+    if verb == "record" and (problem := _record_problem(args)):
+        print(f"aiorobot bag record: error: {problem}", file=sys.stderr)
+        return 2
+    if verb == "check":
+        from ._bag_check import check_main
+
+        return check_main(args)
+    if verb == "convert":
+        from ._bag_convert import convert_main
+
+        return convert_main(args)
+    if verb == "sweep":
+        from ._bag_sweep import sweep_main
+
+        return sweep_main(args)
     try:
         if verb == "info":
             return _info(args.bag)
@@ -108,6 +144,19 @@ def main(args: argparse.Namespace) -> int:
         return 1
     except KeyboardInterrupt:
         return 130
+
+
+def _record_problem(args: argparse.Namespace) -> str:
+    if args.snapshot_mode and not args.max_cache_size:
+        return "--snapshot-mode keeps the last --max-cache-size MB in memory: give --max-cache-size"
+    if args.snapshot_trigger and not args.snapshot_mode:
+        return "--snapshot-trigger needs --snapshot-mode"
+    if args.compression_mode and args.compression_format != "zstd":
+        return f"--compression-mode {args.compression_mode} needs --compression-format zstd (rosbag2's only format)"
+    if args.storage == "sqlite3" and args.compression_format != "none" and not args.compression_mode:
+        return (f"--compression-format {args.compression_format} alone is MCAP chunk compression; with --storage sqlite3 "
+                "add --compression-mode file or message")
+    return ""
 
 
 # -- info / reindex --------------------------------------------------------------------------
@@ -198,10 +247,19 @@ async def _record(args: argparse.Namespace) -> int:
         "exclude": args.exclude,
         "max_bag_size": int((args.max_size or 0) * 1e6),
         "max_bag_duration": args.max_duration or 0.0,
+        "max_cache_size": int((args.max_cache_size or 0) * 1e6),
+        "snapshot_mode": args.snapshot_mode,
+        "snapshot_trigger": args.snapshot_trigger,
+        "storage": args.storage,
+        "compression": "none" if args.compression_mode else args.compression_format,
+        "compression_mode": args.compression_mode,
     }
     if args.output:
         rec_kwargs["path"] = args.output
-    recorder = Recorder(**rec_kwargs)
+    try:
+        recorder = Recorder(**rec_kwargs)
+    except ValueError as err:
+        raise BagError(str(err)) from None
     async with _runtime(args) as rt:
         rt.add_node(recorder)
         print(f"recording to {recorder.path} (Ctrl-C to stop)", file=sys.stderr)

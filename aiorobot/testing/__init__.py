@@ -3,7 +3,8 @@
 The pytest plugin (registered through the ``pytest11`` entry point, so nothing
 to configure) provides the fixtures ``runtime`` (a fresh local ``Runtime`` per
 test, shut down after it), ``sim_runtime`` (the same with ``use_sim_time``) and
-``sim_clock`` (a :class:`SimClock` on ``sim_runtime``)::
+``sim_clock`` (a :class:`SimClock` on ``sim_runtime``), and ``bag_replay`` (a
+:class:`BagReplay`: replay a recorded bag into nodes and compare their outputs)::
 
     async def test_talker_publishes(runtime):
         probe = runtime.add_node(aiorobot.Node("probe"))
@@ -19,8 +20,9 @@ from __future__ import annotations
 
 from .. import Runtime
 from ..lowlevel import wait_for_message
+from ._bag import BagReplay
 from ._sim import ClockPublisher, SimClock
 
 settle = Runtime.settle
 
-__all__ = ["ClockPublisher", "SimClock", "settle", "wait_for_message"]
+__all__ = ["BagReplay", "ClockPublisher", "SimClock", "settle", "wait_for_message"]

@@ -1,4 +1,4 @@
-"""The pytest plugin (entry point ``pytest11``): ``runtime``, ``sim_runtime`` and ``sim_clock`` fixtures."""
+"""The pytest plugin (entry point ``pytest11``): ``runtime``, ``sim_runtime``, ``sim_clock`` and ``bag_replay`` fixtures."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 #: the fixtures this plugin provides; an ``async def`` test using one runs under pytest-asyncio
-FIXTURES = frozenset({"runtime", "sim_runtime", "sim_clock"})
+FIXTURES = frozenset({"runtime", "sim_runtime", "sim_clock", "bag_replay"})
 
 try:
     import pytest_asyncio
@@ -18,6 +18,7 @@ except ImportError:  # pragma: no cover - the fixtures need pytest-asyncio
 
 if pytest_asyncio is not None:
     from .._core._runtime import Runtime
+    from ._bag import BagReplay
     from ._sim import SimClock
 
     @pytest_asyncio.fixture
@@ -38,6 +39,11 @@ if pytest_asyncio is not None:
         clock = SimClock(sim_runtime, start_sec=1.0)
         await clock.start()
         return clock
+
+    @pytest.fixture
+    def bag_replay() -> BagReplay:
+        """A :class:`BagReplay`: ``await bag_replay.assert_matches(path, NodeClass)`` is a regression test."""
+        return BagReplay()
 
 
 @pytest.hookimpl(tryfirst=True)
