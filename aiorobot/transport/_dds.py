@@ -904,26 +904,39 @@ class DdsTransport(Transport):
                 err = "cancelled" if fut.cancelled() else fut.exception()
                 _log.error(f"service {service.srv_name} failed a remote request: {err}; DDS has no error reply, none is sent")
                 return
-            loop.create_task(self._send_reply(side, guid, seq, fut.result()))
+            if side.writer.get_matched_subscriptions():
+                self._write_reply(side, guid, seq, fut.result())  # now: before what after_reply() queued
+            else:
+                loop.create_task(self._reply_when_matched(side, guid, seq, fut.result()))
 
         future.add_done_callback(done)
         service.node._call_soon(service._enqueue, _Call(request, loop, future, guid.to_bytes(8, "little") + bytes(8), seq))
 
-    async def _send_reply(self, side: _ServiceSide, guid: int, seq: int, response: Any) -> None:
-        from cyclonedds._clayer import ddspy_write
+    async def _reply_when_matched(self, side: _ServiceSide, guid: int, seq: int, response: Any) -> None:
+        if await _until(lambda: bool(side.writer.get_matched_subscriptions())):
+            self._write_reply(side, guid, seq, response)
+        else:
+            self._warn("reply", f"no reply reader for a request on {side.service.srv_name}: reply dropped")
 
+    def _write_reply(self, side: _ServiceSide, guid: int, seq: int, response: Any) -> None:
         from ..msgs import serialize
 
-        if not await _until(lambda: bool(side.writer.get_matched_subscriptions())):
-            self._warn("reply", f"no reply reader for a request on {side.service.srv_name}: reply dropped")
-            return
         try:
             data = serialize(response)
         except Exception as err:  # noqa: BLE001
             self._warn("reply", f"could not answer a request on {side.service.srv_name}: {err}")
             return
         if self._participant is not None:
-            ddspy_write(side.writer._ref, _pad(data[:4] + HEADER.pack(guid, seq) + data[4:]))
+            self._write(side.writer, data, guid, seq)
+
+    def _write(self, writer: Any, cdr: bytes, guid: int, seq: int) -> None:
+        """Write ``cdr`` with the request header (guid, seq) after its encapsulation."""
+        from cyclonedds._clayer import ddspy_write
+
+        ret = ddspy_write(writer._ref, _pad(cdr[:4] + HEADER.pack(guid, seq) + cdr[4:]))
+        if ret < 0:
+            self._warn("write", f"Cyclone refused a service message (return code {ret})")
+        else:
             self._sent += 1
 
     def _client_side(self, srv_type: Any, name: str) -> _ClientSide:
@@ -940,8 +953,6 @@ class DdsTransport(Transport):
         self._to_loop(lambda: asyncio.get_running_loop().create_task(self._send_request(side, call)))
 
     async def _send_request(self, side: _ClientSide, call: _Call) -> None:
-        from cyclonedds._clayer import ddspy_write
-
         from ..msgs import serialize
 
         if not await _until(side.matched):
@@ -954,8 +965,7 @@ class DdsTransport(Transport):
             return
         seq = next(side.seq)
         side.pending[seq] = call
-        ddspy_write(side.writer._ref, _pad(data[:4] + HEADER.pack(side.guid, seq) + data[4:]))
-        self._sent += 1
+        self._write(side.writer, data, side.guid, seq)
 
 
 def _with_listener(make: Any, on_data: Any) -> Any:

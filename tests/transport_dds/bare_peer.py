@@ -88,6 +88,7 @@ class ParticipantEntitiesInfo_(IdlStruct, typename="rmw_dds_common::msg::dds_::P
 
 
 # a service request and reply as rmw_cyclonedds sends them: uint64 guid, int64 seq, then the fields
+@dataclass
 class AddTwoInts_Request_(IdlStruct, typename="example_interfaces::srv::dds_::AddTwoInts_Request_"):
     guid: t.uint64
     seq: t.int64
@@ -100,6 +101,58 @@ class AddTwoInts_Response_(IdlStruct, typename="example_interfaces::srv::dds_::A
     guid: t.uint64
     seq: t.int64
     sum: t.int64
+
+
+@dataclass
+class UUID_(IdlStruct, typename="unique_identifier_msgs::msg::dds_::UUID_"):
+    uuid: t.array[t.uint8, 16]
+
+
+@dataclass
+class Fibonacci_Goal_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_Goal_"):
+    order: t.int32
+
+
+@dataclass
+class Fibonacci_Sequence_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_Result_"):
+    sequence: t.sequence[t.int32]
+
+
+@dataclass
+class Fibonacci_SendGoal_Request_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_SendGoal_Request_"):
+    guid: t.uint64
+    seq: t.int64
+    goal_id: UUID_
+    goal: Fibonacci_Goal_
+
+
+@dataclass
+class Fibonacci_SendGoal_Response_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_SendGoal_Response_"):
+    guid: t.uint64
+    seq: t.int64
+    accepted: bool
+    stamp: Time_
+
+
+@dataclass
+class Fibonacci_GetResult_Request_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_GetResult_Request_"):
+    guid: t.uint64
+    seq: t.int64
+    goal_id: UUID_
+
+
+@dataclass
+class Fibonacci_GetResult_Response_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_GetResult_Response_"):
+    guid: t.uint64
+    seq: t.int64
+    status: t.int8
+    result: Fibonacci_Sequence_
+
+
+@dataclass
+class Fibonacci_FeedbackMessage_(IdlStruct, typename="example_interfaces::action::dds_::Fibonacci_FeedbackMessage_"):
+    goal_id: UUID_
+    feedback: Fibonacci_Sequence_
 
 
 TYPES = {c.__name__.rstrip("_"): c for c in (String_, Twist_, Image_, AddTwoInts_Request_, AddTwoInts_Response_)}
@@ -257,6 +310,34 @@ def handle(c: dict) -> dict:
         replies: list = []
         wait(lambda: replies.extend(s for s in rep_r.take(10) if s.guid == guid) or replies, 10)
         return {"replies": [{"guid": s.guid, "seq": s.seq, "sum": s.sum} for s in replies]}
+    if op == "action":  # a Fibonacci goal through <action>/_action/{send_goal,get_result,feedback}
+        base = c["action"] + "/_action/"
+        h = c["hashes"]
+        pairs = {}
+        for name, req, rep in (("send_goal", Fibonacci_SendGoal_Request_, Fibonacci_SendGoal_Response_),
+                               ("get_result", Fibonacci_GetResult_Request_, Fibonacci_GetResult_Response_)):
+            w = DataWriter(dp, topic(f"rq{base}{name}Request", req), qos({}, h[name + "_req"], "clientid=8;"))
+            r = DataReader(dp, topic(f"rr{base}{name}Reply", rep), qos({}, h[name + "_rep"], "clientid=8;"))
+            pairs[name] = (w, r)
+        fb = DataReader(dp, topic(f"rt{base}feedback", Fibonacci_FeedbackMessage_), qos({}, h["feedback"]))
+        ok = wait(lambda: all(w.get_matched_subscriptions() and r.get_matched_publications() for w, r in pairs.values())
+                  and fb.get_matched_publications(), 10)
+        if not ok:
+            return {"error": "action server not matched"}
+        goal_id = UUID_(uuid=list(range(16)))
+        guid = 0x1122334455667788
+
+        def call(name, request):
+            w, r = pairs[name]
+            w.write(request)
+            got = []
+            wait(lambda: got.extend(s for s in r.take(10) if s.guid == guid) or got, 20)
+            return got[0]
+
+        accepted = call("send_goal", Fibonacci_SendGoal_Request_(guid=guid, seq=1, goal_id=goal_id, goal=Fibonacci_Goal_(order=c["order"])))
+        result = call("get_result", Fibonacci_GetResult_Request_(guid=guid, seq=2, goal_id=goal_id))
+        feedback = [list(s.feedback.sequence) for s in fb.take(100) if bytes(s.goal_id.uuid) == bytes(range(16))]
+        return {"accepted": accepted.accepted, "status": result.status, "sequence": list(result.result.sequence), "feedback": feedback}
     if op == "guid":
         return {"guid": dp.guid.bytes.hex()}
     raise ValueError(f"unknown op {op!r}")
