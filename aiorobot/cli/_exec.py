@@ -16,10 +16,13 @@ _ENTRY_POINT = re.compile(r"[A-Za-z_][\w.]*:[A-Za-z_][\w.]*")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from .._core._transport import transport_names
+
     parser.add_argument(
-        "--transport", choices=("local", "zenoh"), default="local",
+        "--transport", choices=transport_names(), default="local",
         help="local: the program's nodes talk in-process (default); zenoh: with other processes "
-        "(ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE apply, as in rmw_zenoh)",
+        "(ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE apply, as in rmw_zenoh); dds: with ROS 2 "
+        "nodes on DDS (ROS_DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE, CYCLONEDDS_URI apply, docs/dds.md)",
     )
     parser.add_argument(
         "--node", action="append", default=[], metavar="MODULE:CLASS",

@@ -27,7 +27,7 @@ from typing import Any
 from .._core._errors import ConfigError, InvalidNameError
 from .._core._names import expand_name, validate_namespace, validate_node_name
 from .._core._runtime import EXECUTORS, PRIORITY_STALL_THRESHOLD_SEC, SHUTDOWN_TIMEOUT_SEC, STALL_THRESHOLD_SEC
-from .._core._transport import MAX_DOMAIN_ID
+from .._core._transport import MAX_DOMAIN_ID, transport_names
 
 __all__ = [
     "EXECUTORS",
@@ -41,15 +41,12 @@ __all__ = [
     "RESTART_POLICIES",
     "RecordConfig",
     "RuntimeConfig",
-    "TRANSPORTS",
     "build_nodes",
     "load_config",
     "parse_config",
 ]
 
 LOG_LEVELS = ("debug", "info", "warning", "error")
-TRANSPORTS = ("local", "zenoh")
-_AVAILABLE_TRANSPORTS = ("local", "zenoh")
 
 _RUNTIME_KEYS = (
     "transport",
@@ -321,17 +318,12 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
     """``default_transport`` is "zenoh" when a node runs in another process (processes meet over zenoh)."""
     checker.check_type(table, "runtime", dict, "a table ([runtime])")
     checker.check_keys(table, "runtime", _RUNTIME_KEYS)
-    transport = checker.choice(table, "runtime", "transport", TRANSPORTS, default_transport)
+    transport = checker.choice(table, "runtime", "transport", transport_names(), default_transport)
     if default_transport == "zenoh" and transport != "zenoh":
         raise checker.error(
             "runtime.transport",
             'a [[nodes]] process key puts a node in another process, which needs transport = "zenoh" '
             f'(or no transport key), found "{transport}"',
-        )
-    if transport not in _AVAILABLE_TRANSPORTS:
-        raise checker.error(
-            "runtime.transport",
-            f'the "{transport}" transport is not available yet; expected "local"',
         )
     domain_id = table.get("domain_id", 0)
     checker.check_type(domain_id, "runtime.domain_id", int, f"an integer 0..{MAX_DOMAIN_ID}")
