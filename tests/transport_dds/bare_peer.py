@@ -178,6 +178,12 @@ def qos(c: dict, hash_: str, extra: str = "") -> Qos:
     history = Policy.History.KeepLast(depth)
     p = [history, Policy.Userdata(f"{extra}typehash={hash_};".encode()) if hash_ else Policy.Userdata(extra.encode())]
     p.append(Policy.Reliability.BestEffort if c.get("best_effort") else Policy.Reliability.Reliable(INF))
+    if c.get("deadline_ns"):
+        p.append(Policy.Deadline(c["deadline_ns"]))
+    if c.get("lifespan_ns"):
+        p.append(Policy.Lifespan(c["lifespan_ns"]))
+    if c.get("lease_ns"):
+        p.append(Policy.Liveliness.ManualByTopic(c["lease_ns"]))
     if c.get("tl"):
         p += [Policy.Durability.TransientLocal, Policy.DurabilityService(0, history, -1, -1, -1)]
     else:
@@ -203,6 +209,7 @@ def scan() -> None:
                     "kind": kind, "topic": s.topic_name, "type": s.type_name,
                     "participant": str(s.participant_key), "guid": s.key.bytes.hex(),
                     "userdata": ud.data.decode() if ud is not None else "",
+                    "qos": [repr(p) for p in s.qos],
                 }
 
 
