@@ -110,4 +110,5 @@ async def test_qos_policies_reach_the_wire_and_come_back(peer: BarePeer, domain_
 def test_a_config_file_may_choose_the_dds_transport() -> None:
     from aiorobot.launch import parse_config
 
-    assert parse_config({"runtime": {"transport": "dds", "domain_id": 5}}).runtime.transport == "dds"
+    config = parse_config({"runtime": {"transport": "dds"}, "nodes": [{"use": "aiorobot.examples.sensor:ImuPublisher"}]})
+    assert config.runtime.transport == "dds"
