@@ -33,7 +33,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from .._core._errors import ServiceError
-from .._core._handoff import post
 from .._core._pubsub import Publisher, Subscription, Tap
 from .._core._qos import QoSProfile, ReliabilityPolicy
 from .._core._services import Client, Service, _Call, _reply
@@ -52,7 +51,7 @@ from ._dds_wire import (
     topic_name,
     user_data,
 )
-from ._zenoh import _FALLBACK_QOS, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer
+from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer
 
 if TYPE_CHECKING:
     from .._core._bus import Bus
@@ -63,10 +62,9 @@ __all__ = ["DdsStatistics", "DdsTransport"]
 
 _log = logging.getLogger("aiorobot.transport")
 
-WARN_INTERVAL_SEC = 1.0
 #: how long a call or a reply waits for the other side's reader to be matched before it is written
 MATCH_TIMEOUT_SEC = 5.0
-#: what a remote service has to match before a call is sent (rmw_cyclonedds's server waits 100 ms)
+#: samples taken from a reader per listener call
 _TAKE_MAX = 256
 _SERVICE_QOS = QoSProfile()
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
@@ -426,7 +424,7 @@ class DdsTransport(Transport):
         self._endpoint_gids: dict[int, list[bytes]] = {}  # id(endpoint) -> gids announced for it
         self._remote: dict[bytes, Any] = {}  # remote endpoint GUID -> what it added to the bus (None: nothing)
         self._remote_info: dict[bytes, Any] = {}  # remote endpoint GUID -> (participant, parsed name, kind)
-        self._by_handle: dict[int, _Injector] = {}
+        self._by_gid: dict[int, _Injector] = {}  # publication handle -> injector
         self._handle_of: dict[bytes, int] = {}
         self._blocked: set[int] = set()
         self._participants: dict[bytes, list[_RemoteNode]] = {}
@@ -533,24 +531,14 @@ class DdsTransport(Transport):
 
     # -- helpers ---------------------------------------------------------------------------
 
-    def _warn(self, reason: str, text: str) -> None:
-        self._drops[reason] += 1
-        now = time.monotonic()
-        if now - self._last_warning.get(reason, -1e9) >= WARN_INTERVAL_SEC:
-            self._last_warning[reason] = now
-            _log.warning(f"{text} ({self._drops[reason]} dropped so far for this reason)")
-
-    def _to_loop(self, fn: Any, *args: Any) -> None:
-        if self._loop is not None:
-            post(self._loop, fn, *args)
-
-    def _hash(self, msg_type: Any) -> str:
-        cached = self._hashes.get(msg_type)
-        if cached is None:
-            from ..msgs import type_hash
-
-            cached = self._hashes[msg_type] = type_hash(msg_type)
-        return cached
+    # The bus side is the zenoh transport's: throttled, counted warnings; the hop to the main loop;
+    # cached type hashes; a received message published into the bus by its remote publisher's
+    # injector (``_by_gid``: here keyed by the DDS publication handle); a remote endpoint joined to it.
+    _warn = ZenohTransport._warn
+    _to_loop = ZenohTransport._to_loop
+    _hash = ZenohTransport._hash
+    _inject = ZenohTransport._inject
+    _add_to_bus = ZenohTransport._add_to_bus
 
     def _endpoint_id(self) -> str:
         """rmw_cyclonedds's ``clientid``/``serviceid``: the participant GUID prefix and a counter, as
@@ -749,13 +737,13 @@ class DdsTransport(Transport):
             injector = _Injector(self._owner, cls, parsed.name, qos, node)
             self._remote[guid] = injector
             handle = s.sample_info.instance_handle
-            self._by_handle[handle] = injector
+            self._by_gid[handle] = injector
             self._handle_of[guid] = handle
-            self._add_to_bus(guid, injector)
+            self._add_to_bus(injector)
         elif parsed.kind == "topic":
             tap = Tap(cls, parsed.name, qos, _ignore, owner=node)
             self._remote[guid] = tap
-            self._add_to_bus(guid, tap)
+            self._add_to_bus(tap)
         elif parsed.kind == "request" and kind == "reader":
             server = _RemoteServer(self, cls, parsed.name, "", node)  # type: ignore[arg-type]
             self._remote[guid] = server
@@ -765,22 +753,11 @@ class DdsTransport(Transport):
             self._remote[guid] = client
             bus.services.add(client)  # type: ignore[arg-type]
 
-    def _add_to_bus(self, guid: bytes, endpoint: Any) -> None:
-        assert self.bus is not None
-        try:
-            if isinstance(endpoint, Publisher):
-                self.bus.add_publisher(endpoint)
-            else:
-                self.bus.add_subscription(endpoint)
-        except Exception as err:  # noqa: BLE001 - strict_qos refuses it: the warning is the report
-            _log.error(f"remote endpoint not connected: {err}")
-            self._remote[guid] = None
-
     def _forget(self, guid: bytes) -> None:
         entry = self._remote.pop(guid, None)
         handle = self._handle_of.pop(guid, None)
         if handle is not None:
-            self._by_handle.pop(handle, None)
+            self._by_gid.pop(handle, None)
         bus = self.bus
         if entry is None or bus is None:
             return
@@ -874,21 +851,6 @@ class DdsTransport(Transport):
         inb.declare(sub.qos)
         for s in inb.subscriptions:
             self._track(s, inb.reader)
-
-    def _inject(self, inbound: _Inbound, handle: int, msg: Any) -> None:
-        """On the main loop: publish a received message into the bus as its remote publisher."""
-        injector = self._by_handle.get(handle)
-        if injector is None or injector.topic_name != inbound.topic or injector.msg_type is not inbound.msg_type:
-            injector = inbound.fallback
-        if injector.destroyed:
-            return
-        self._local.injecting = True
-        try:
-            injector.publish(msg)
-        except Exception as err:  # noqa: BLE001
-            self._warn("inject", f"could not deliver a message on {inbound.topic}: {err}")
-        finally:
-            self._local.injecting = False
 
     # -- services ------------------------------------------------------------------------------
 
