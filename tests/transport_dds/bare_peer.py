@@ -317,7 +317,7 @@ def handle(c: dict) -> dict:
         replies: list = []
         wait(lambda: replies.extend(s for s in rep_r.take(10) if s.guid == guid) or replies, 10)
         return {"replies": [{"guid": s.guid, "seq": s.seq, "sum": s.sum} for s in replies]}
-    if op == "action":  # a Fibonacci goal through <action>/_action/{send_goal,get_result,feedback}
+    if op == "action_client":  # the endpoints of a Fibonacci action client, matched with the server
         base = c["action"] + "/_action/"
         h = c["hashes"]
         pairs = {}
@@ -331,6 +331,10 @@ def handle(c: dict) -> dict:
                   and fb.get_matched_publications(), 10)
         if not ok:
             return {"error": "action server not matched"}
+        entities["action"] = (pairs, fb)
+        return {}
+    if op == "action":  # a Fibonacci goal through <action>/_action/{send_goal,get_result,feedback}
+        pairs, fb = entities["action"]
         goal_id = UUID_(uuid=list(range(16)))
         guid = 0x1122334455667788
 

@@ -79,7 +79,10 @@ async def test_a_bare_action_client_reaches_an_aiorobot_action_server(peer: Bare
             "get_result_req": type_hash(Fibonacci.GetResult.Request), "get_result_rep": type_hash(Fibonacci.GetResult.Response),
             "feedback": type_hash(Fibonacci.FeedbackMessage),
         }
-        out = await peer.cmd(op="action", action="/fibonacci", order=5, hashes=hashes)
+        await peer.cmd(op="action_client", action="/fibonacci", hashes=hashes)
+        # the server's feedback writer has learnt of the client's reader too (DDS matches each side apart)
+        await wait_until(lambda: node.count_subscribers("/fibonacci/_action/feedback") == 1)
+        out = await peer.cmd(op="action", order=5)
     assert out["accepted"] is True
     assert out["status"] == 4  # STATUS_SUCCEEDED
     assert out["sequence"] == [0, 1, 1, 2, 3, 5]
