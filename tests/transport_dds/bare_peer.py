@@ -45,6 +45,11 @@ class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
 
 
 @dataclass
+class Int32_(IdlStruct, typename="std_msgs::msg::dds_::Int32_"):
+    data: t.int32
+
+
+@dataclass
 class Vector3_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
     x: t.float64
     y: t.float64
@@ -155,7 +160,7 @@ class Fibonacci_FeedbackMessage_(IdlStruct, typename="example_interfaces::action
     feedback: Fibonacci_Sequence_
 
 
-TYPES = {c.__name__.rstrip("_"): c for c in (String_, Twist_, Image_, AddTwoInts_Request_, AddTwoInts_Response_)}
+TYPES = {c.__name__.rstrip("_"): c for c in (String_, Int32_, Twist_, Image_, AddTwoInts_Request_, AddTwoInts_Response_)}
 HASH_PEI = "RIHS01_91a0593bacdcc50ea9bdcf849a938b128412cc1ea821245c663bcd26f83c295e"
 
 domain_id = int(os.environ.get("ROS_DOMAIN_ID", "0"))

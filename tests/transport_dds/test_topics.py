@@ -147,3 +147,17 @@ async def test_a_type_hash_mismatch_is_reported_and_not_delivered(peer: BarePeer
             await wait_until(lambda: rt.transport.statistics().drop_reasons.get("type_hash", 0) >= 2)
         assert got == [] and node.count_publishers("/chatter") == 0
         assert "RIHS01_abab" in caplog.text and H_STRING in caplog.text
+
+
+async def test_a_remote_type_name_or_qos_mismatch_is_reported_as_on_the_bus(peer: BarePeer, domain_id: int) -> None:
+    from aiorobot.msgs.std_msgs import Int32
+
+    async with dds_runtime(domain_id) as rt:
+        node = rt.add_node(Node("picky"))
+        node.create_subscription(String, "/chatter", lambda m: None, 10)
+        node.create_subscription(String, "/reliable_only", lambda m: None, 10)
+        await peer.cmd(op="writer", id="i", topic="rt/chatter", type="Int32", hash=type_hash(Int32))
+        await peer.cmd(op="writer", id="b", topic="rt/reliable_only", type="String", hash=H_STRING, best_effort=True)
+        await wait_until(lambda: len(rt.graph.incompatible_qos) == 2)
+        found = {(i.topic, i.kind, i.subscription_node) for i in rt.graph.incompatible_qos}
+    assert found == {("/chatter", "type mismatch", "/picky"), ("/reliable_only", "incompatible QoS", "/picky")}
