@@ -19,11 +19,11 @@ import os
 from typing import Any
 
 from .._core._transport import MAX_DOMAIN_ID, register_transport
-from ._dds import DdsStatistics, DdsTransport
+from ._dds import DdsConfigError, DdsStatistics, DdsTransport
 from ._session_config import ZenohConfigError, ZenohSessionError
 from ._zenoh import TransportStatistics, ZenohTransport
 
-__all__ = ["DdsStatistics", "DdsTransport", "TransportStatistics", "ZenohConfigError", "ZenohSessionError", "ZenohTransport"]
+__all__ = ["DdsConfigError", "DdsStatistics", "DdsTransport", "TransportStatistics", "ZenohConfigError", "ZenohSessionError", "ZenohTransport"]
 
 
 def _env_domain(domain_id: int) -> int:

@@ -32,7 +32,7 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from .._core._errors import ServiceError
+from .._core._errors import ConfigError, ServiceError
 from .._core._pubsub import Publisher, Subscription, Tap
 from .._core._qos import QoSProfile, ReliabilityPolicy
 from .._core._services import Client, Service, _Call, _reply
@@ -58,16 +58,24 @@ if TYPE_CHECKING:
     from .._core._graph import NodeInfo
     from .._core._node import Node
 
-__all__ = ["DdsStatistics", "DdsTransport"]
+__all__ = ["DdsConfigError", "DdsStatistics", "DdsTransport"]
 
 _log = logging.getLogger("aiorobot.transport")
 
 #: how long a call or a reply waits for the other side's reader to be matched before it is written
 MATCH_TIMEOUT_SEC = 5.0
+#: Cyclone's DDS_RETCODE_PRECONDITION_NOT_MET: the domain exists in this process already
+_PRECONDITION_NOT_MET = -4
 #: samples taken from a reader per listener call
 _TAKE_MAX = 256
 _SERVICE_QOS = QoSProfile()
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
+
+
+class DdsConfigError(ConfigError, ValueError):
+    """Cyclone refused its configuration (``CYCLONEDDS_URI``, the discovery variables, or
+    ``DdsTransport(config=)``): ``path`` names where it came from. Nothing was opened; Cyclone's own
+    line on stderr names the element at fault."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -450,24 +458,43 @@ class DdsTransport(Transport):
         config, warnings = (self.config, []) if self.config is not None else discovery_config()
         for text in warnings:
             _log.warning(text)
+        await asyncio.to_thread(self._open_domain, config)  # a bad configuration: DdsConfigError, nothing opened
         await super().open(bus)
         self._loop = asyncio.get_running_loop()
         self._owner = _Owner(self._loop, threading.get_ident(), "<dds>")
-        await asyncio.to_thread(self._open_participant, config)
+        await asyncio.to_thread(self._open_participant)
         bus.services.listener = self  # type: ignore[attr-defined]
 
-    def _open_participant(self, config: str) -> None:
+    def _open_domain(self, config: str) -> None:
+        from cyclonedds.core import DDSException
+        from cyclonedds.domain import Domain
+
+        try:
+            self._domain = Domain(self.domain_id, config)
+        except DDSException as err:
+            if err.code == _PRECONDITION_NOT_MET:
+                self._domain = None  # this process already has the domain (another runtime): shared as it is
+                return
+            if self.config is not None:
+                where = "DdsTransport(config=)"
+            elif os.environ.get("CYCLONEDDS_URI", "").strip():
+                where = "CYCLONEDDS_URI"
+            else:
+                where = "ROS_AUTOMATIC_DISCOVERY_RANGE / ROS_STATIC_PEERS"
+            shown = config if len(config) <= 200 else config[:200] + "..."
+            raise DdsConfigError(
+                where, None, f"Cyclone DDS refused the configuration of domain {self.domain_id} ({shown!r}): "
+                "expected a file:// URI or <CycloneDDS> XML it accepts; its own line above names what is wrong",
+            ) from None
+
+    def _open_participant(self) -> None:
         from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
-        from cyclonedds.core import DDSException, Policy, Qos
-        from cyclonedds.domain import Domain, DomainParticipant
+        from cyclonedds.core import Policy, Qos
+        from cyclonedds.domain import DomainParticipant
         from cyclonedds.pub import DataWriter
 
         from ..msgs.rmw_dds_common import ParticipantEntitiesInfo
 
-        try:
-            self._domain = Domain(self.domain_id, config)
-        except DDSException:
-            self._domain = None  # this process already has the domain (another runtime): it is shared as is
         self._participant = DomainParticipant(self.domain_id, qos=Qos(Policy.Userdata(f"enclave={self.enclave};".encode())))
         self._guid = self._participant.guid.bytes
         info_type = idl_struct(ParticipantEntitiesInfo)

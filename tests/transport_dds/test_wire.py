@@ -112,3 +112,30 @@ def test_a_config_file_may_choose_the_dds_transport() -> None:
 
     config = parse_config({"runtime": {"transport": "dds"}, "nodes": [{"use": "aiorobot.examples.sensor:ImuPublisher"}]})
     assert config.runtime.transport == "dds"
+
+
+async def test_a_configuration_cyclone_refuses_is_one_config_error_and_nothing_opens(domain_id: int) -> None:
+    from aiorobot import Runtime
+    from aiorobot.transport import DdsConfigError, DdsTransport
+
+    transport = DdsTransport(domain_id=domain_id, config="<CycloneDDS><Domain><Bogus>1</Bogus></Domain></CycloneDDS>")
+    with pytest.raises(DdsConfigError, match=r"^DdsTransport\(config=\): Cyclone DDS refused the configuration of domain"):
+        async with Runtime(transport=transport, handle_signals=False):
+            pass
+    assert transport.guid == b"" and transport.bus is None
+
+
+async def test_the_cli_says_in_one_line_that_cyclonedds_uri_is_unusable(domain_id: int) -> None:
+    import asyncio
+    import sys
+
+    from ._helpers import dds_env
+
+    env = dds_env(domain_id) | {"CYCLONEDDS_URI": "file:///nonexistent/cyclone.xml"}
+    proc = await asyncio.create_subprocess_exec(
+        sys.executable, "-m", "aiorobot.cli", "node", "list", "--transport", "dds",
+        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE, env=env)
+    out, err = await proc.communicate()
+    lines = [line for line in err.decode().splitlines() if line.startswith("CYCLONEDDS_URI")]
+    assert proc.returncode == 2 and out == b""
+    assert len(lines) == 1 and "Cyclone DDS refused the configuration" in lines[0] and "Traceback" not in err.decode()
