@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from typing import Any
 
 import numpy as np
 import pytest
@@ -58,16 +59,23 @@ async def test_aiorobot_publishers_reach_a_bare_reader_with_byte_identical_cdr(p
         for rid, topic, kind in (("s", "rt/chatter", "String"), ("t", "rt/cmd_vel", "Twist"), ("i", "rt/image", "Image")):
             await peer.cmd(op="reader", id=rid, topic=topic, type=kind)
         await wait_until(lambda: all(p.get_subscription_count() == 1 for p, _ in pubs.values()))
-        for pub, msg in pubs.values():
-            pub.publish(msg)
-        s = (await peer.cmd(op="take", id="s"))["samples"]
-        t = (await peer.cmd(op="take", id="t"))["samples"]
-        i = (await peer.cmd(op="take", id="i"))["samples"]
-    assert s == [{"data": "hi"}]
+        s, t, i = [await _published_until_taken(peer, rid, *pubs[rid]) for rid in ("s", "t", "i")]
+    assert s[0] == {"data": "hi"}
     assert t[0]["linear"]["x"] == 1.5 and t[0]["angular"]["z"] == 0.25
     assert i[0]["data"] == [0, 1, 2, 3, 4, 5] and i[0]["encoding"] == "mono8"
     # what the bare side decoded is what ROS 2's CDR of the same message is
     assert serialize(String(data="hi")) == bytes.fromhex("00010000030000006869" "00")
+
+
+async def _published_until_taken(peer: BarePeer, reader: str, pub: Any, msg: Any) -> list[dict[str, Any]]:
+    """Publish ``msg`` until the bare reader has it: the remote reader is in the graph once discovered,
+    which can come a moment before Cyclone has matched it with this side's writer."""
+    take = asyncio.ensure_future(peer.cmd(op="take", id=reader, timeout=20))
+    while not take.done():
+        pub.publish(msg)
+        await asyncio.wait([take], timeout=0.05)
+    samples: list[dict[str, Any]] = take.result()["samples"]
+    return samples
 
 
 async def test_a_late_joiner_gets_a_transient_local_history_both_ways(peer: BarePeer, domain_id: int) -> None:
