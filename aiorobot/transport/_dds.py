@@ -488,7 +488,12 @@ class DdsTransport(Transport):
             ) from None
 
     def _open_participant(self) -> None:
-        from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
+        from cyclonedds.builtin import (
+            BuiltinDataReader,
+            BuiltinTopicDcpsParticipant,
+            BuiltinTopicDcpsPublication,
+            BuiltinTopicDcpsSubscription,
+        )
         from cyclonedds.core import Policy, Qos
         from cyclonedds.domain import DomainParticipant
         from cyclonedds.pub import DataWriter
@@ -505,8 +510,9 @@ class DdsTransport(Transport):
         )
         reader_qos = dds_qos(QoSProfile(durability=1, history=2, depth=0))  # keep all
         self._discovery_reader = self._reader(DISCOVERY_TOPIC, info_type, _cyclone_qos(reader_qos, data, reader=True), self._on_discovery)
-        for topic in (BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription):
-            kind = "writer" if topic is BuiltinTopicDcpsPublication else "reader"
+        kinds = {BuiltinTopicDcpsParticipant: "participant", BuiltinTopicDcpsPublication: "writer",
+                 BuiltinTopicDcpsSubscription: "reader"}
+        for topic, kind in kinds.items():
             self._builtin.append(_with_listener(
                 lambda listener, t=topic: BuiltinDataReader(self._participant, t, listener=listener),
                 lambda r, k=kind: self._on_builtin(r, k),
@@ -713,6 +719,11 @@ class DdsTransport(Transport):
             return
         guid = s.key.bytes
         with self._lock:
+            if kind == "participant":
+                if not alive and self._participants.pop(guid, None) is not None:  # its nodes leave the graph
+                    for gid in [g for g, _ in self._gid_node.items() if g[:12] == guid[:12]]:
+                        del self._gid_node[gid]
+                return
             if not alive:
                 self._forget(guid)
                 return

@@ -354,6 +354,9 @@ def handle(c: dict) -> dict:
         result = call("get_result", Fibonacci_GetResult_Request_(guid=guid, seq=2, goal_id=goal_id))
         feedback = [list(s.feedback.sequence) for s in fb.take(100) if bytes(s.goal_id.uuid) == bytes(range(16))]
         return {"accepted": accepted.accepted, "status": result.status, "sequence": list(result.result.sequence), "feedback": feedback}
+    if op == "leave":  # leave cleanly: deleting the participant disposes it and its endpoints at once
+        dp.__del__()
+        return {}
     if op == "guid":
         return {"guid": dp.guid.bytes.hex()}
     raise ValueError(f"unknown op {op!r}")

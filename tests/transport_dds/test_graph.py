@@ -31,6 +31,9 @@ async def test_aiorobot_names_a_bare_peers_node_and_its_endpoints(peer: BarePeer
         await wait_until(lambda: [p.node for p in rt.graph.publishers_of("/chatter")] == ["/bare/talker"])
         await wait_until(lambda: any(s.name == "/add_two_ints" and s.servers == ("/bare/talker",) for s in rt.graph.services))
         assert rt.transport.remote_nodes()[0].namespace == "/bare"
+        await peer.cmd(op="leave")
+        await wait_until(lambda: rt.graph.node("/bare/talker") is None and not rt.graph.publishers_of("/chatter"))
+        assert not any(s.name == "/add_two_ints" for s in rt.graph.services)
 
 
 async def test_a_bare_peer_reads_aiorobots_nodes_with_their_endpoint_gids(peer: BarePeer, domain_id: int) -> None:
