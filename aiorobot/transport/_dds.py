@@ -428,8 +428,8 @@ class DdsTransport(Transport):
         self._inbound: dict[tuple[str, str], _Inbound] = {}
         self._services: dict[int, _ServiceSide] = {}
         self._clients: dict[tuple[str, str], _ClientSide] = {}
-        self._node_gids: dict[int, tuple[Node, set[bytes]]] = {}  # id(node) -> (node, gids of its endpoints)
-        self._endpoint_gids: dict[int, list[bytes]] = {}  # id(endpoint) -> gids announced for it
+        self._local_nodes: dict[int, Node] = {}
+        self._endpoint_gids: dict[int, tuple[Node, set[bytes]]] = {}  # id(endpoint) -> (its node, its DDS entities' GIDs)
         self._remote: dict[bytes, Any] = {}  # remote endpoint GUID -> what it added to the bus (None: nothing)
         self._remote_info: dict[bytes, Any] = {}  # remote endpoint GUID -> (participant, parsed name, kind)
         self._by_gid: dict[int, _Injector] = {}  # publication handle -> injector
@@ -608,26 +608,18 @@ class DdsTransport(Transport):
         node = getattr(endpoint, "node", None)
         if node is None or isinstance(node, _Owner):
             return
-        gids = [e.guid.bytes for e in entities]
-        self._endpoint_gids.setdefault(id(endpoint), []).extend(gids)
-        self._node_gids.setdefault(id(node), (node, set()))[1].update(gids)
+        self._local_nodes.setdefault(id(node), node)
+        self._endpoint_gids.setdefault(id(endpoint), (node, set()))[1].update(e.guid.bytes for e in entities)
         self._announce_soon()
 
     def _untrack(self, endpoint: Any) -> None:
-        gids = self._endpoint_gids.pop(id(endpoint), [])
-        node = getattr(endpoint, "node", None)
-        entry = self._node_gids.get(id(node))
-        if entry is not None:
-            still = {g for k, gs in self._endpoint_gids.items() for g in gs}
-            entry[1].difference_update(g for g in gids if g not in still)
+        self._endpoint_gids.pop(id(endpoint), None)
         self._announce_soon()
 
     def _forget_gid(self, entity: Any) -> None:
+        """A DDS entity was replaced or deleted: no endpoint announces it any more."""
         gid = entity.guid.bytes
-        for gids in self._endpoint_gids.values():
-            if gid in gids:
-                gids.remove(gid)
-        for _node, gids in self._node_gids.values():
+        for _node, gids in self._endpoint_gids.values():
             gids.discard(gid)
 
     def _announce_soon(self) -> None:
@@ -648,7 +640,8 @@ class DdsTransport(Transport):
         readers = self._reader_gids()
         nodes = []
         with self._lock:
-            for node, gids in self._node_gids.values():
+            for node in self._local_nodes.values():
+                gids = set().union(*(g for n, g in self._endpoint_gids.values() if n is node))
                 nodes.append(NodeEntitiesInfo(
                     node_namespace=node.get_namespace() or "/", node_name=node.get_name(),
                     reader_gid_seq=[Gid(data=list(g)) for g in sorted(gids) if g in readers],
@@ -809,12 +802,12 @@ class DdsTransport(Transport):
 
     def node_added(self, node: Node) -> None:
         with self._lock:
-            self._node_gids.setdefault(id(node), (node, set()))
+            self._local_nodes[id(node)] = node
         self._announce_soon()
 
     def node_removed(self, node: Node) -> None:
         with self._lock:
-            self._node_gids.pop(id(node), None)
+            self._local_nodes.pop(id(node), None)
         self._announce_soon()
 
     # -- local endpoints ------------------------------------------------------------------------

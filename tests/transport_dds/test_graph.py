@@ -73,3 +73,25 @@ async def test_the_graph_cli_lists_a_bare_peers_node_topic_and_service(peer: Bar
     assert "Node name: talker\nNode namespace: /bare\n" in info and "Type: std_msgs/msg/String" in info
     assert "Endpoint type: PUBLISHER" in info and "Reliability: RELIABLE" in info and "KEEP_LAST (10)" in info
     assert "/add_two_ints" in services.split()
+
+
+async def test_endpoints_that_leave_leave_their_nodes_gid_lists(peer: BarePeer, domain_id: int) -> None:
+    async with dds_runtime(domain_id) as rt:
+        first = rt.add_node(Node("first"))
+        second = rt.add_node(Node("second"))
+        kept = first.create_publisher(String, "/chatter", 10)
+        gone = second.create_publisher(String, "/chatter", 10)  # the same DDS writer serves both
+        writer = (await peer.cmd(op="endpoints", topic="rt/chatter"))["endpoints"][0]["guid"]
+        nodes = await peer.cmd(op="nodes", expect="/second")
+
+        def writers(info: dict, name: str) -> list[str]:
+            return [w for ns in info["participants"].values() for n in ns if n["name"] == name for w in n["writers"]]
+
+        assert writer in writers(nodes, "/first") and writer in writers(nodes, "/second")
+        second.destroy_publisher(gone)
+        async with asyncio.timeout(20):  # each participant state replaces the one before: read until the new one
+            while True:
+                later = await peer.cmd(op="nodes", expect="/second", timeout=0.5)
+                if writer in writers(later, "/first") and writer not in writers(later, "/second"):
+                    break
+        assert kept.get_subscription_count() == 0
