@@ -14,7 +14,8 @@ import threading
 import time
 from dataclasses import asdict, dataclass
 
-from cyclonedds._clayer import ddspy_write
+from cyclonedds._clayer import ddspy_take, ddspy_write
+from cyclonedds.core import InstanceState, SampleState, ViewState
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
 from cyclonedds.core import Policy, Qos
 from cyclonedds.domain import Domain, DomainParticipant
@@ -259,6 +260,12 @@ def handle(c: dict) -> dict:
 
         wait(enough, c.get("timeout", 10))
         return {"samples": [_plain(asdict(s)) for s in got]}
+    if op == "take_raw":  # the serialized samples as they arrived, in hex
+        r = entities[c["id"]]
+        raw: list = []
+        mask = SampleState.Any | ViewState.Any | InstanceState.Any
+        wait(lambda: raw.extend(d.hex() for d, i in ddspy_take(r._ref, mask, 100) if i.valid_data) or raw, c.get("timeout", 10))
+        return {"raw": raw}
     if op == "endpoints":
         def found():
             scan()
