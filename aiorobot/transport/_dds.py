@@ -431,7 +431,7 @@ class DdsTransport(Transport):
         self._local_nodes: dict[int, Node] = {}
         self._endpoint_gids: dict[int, tuple[Node, set[bytes]]] = {}  # id(endpoint) -> (its node, its DDS entities' GIDs)
         self._remote: dict[bytes, Any] = {}  # remote endpoint GUID -> what it added to the bus (None: nothing)
-        self._remote_info: dict[bytes, Any] = {}  # remote endpoint GUID -> (participant, parsed name, kind)
+        self._clientids: dict[int, str] = {}  # remote request writer's publication handle -> its clientid
         self._by_gid: dict[int, _Injector] = {}  # publication handle -> injector
         self._handle_of: dict[bytes, int] = {}
         self._blocked: set[int] = set()
@@ -718,8 +718,13 @@ class DdsTransport(Transport):
                         del self._gid_node[gid]
                 return
             if not alive:
+                self._clientids.pop(s.sample_info.instance_handle, None)
                 self._forget(guid)
                 return
+            if kind == "writer" and (s.topic_name or "").startswith("rq/"):
+                clientid = parse_user_data(_user_data_of(s)).get("clientid")
+                if clientid is not None:
+                    self._clientids[s.sample_info.instance_handle] = clientid
             if s.participant_key.bytes == self._guid or guid in self._remote:
                 return
             parsed = parse_endpoint(s.topic_name or "", s.type_name or "")
@@ -732,8 +737,6 @@ class DdsTransport(Transport):
                 self._warn("discovery", f"could not add remote {kind} on {s.topic_name}: {err}")
 
     def _learn(self, guid: bytes, kind: str, parsed: Any, s: Any) -> None:
-        from cyclonedds.core import Policy
-
         from ..msgs import get
 
         bus = self.bus
@@ -752,8 +755,7 @@ class DdsTransport(Transport):
             cls_hash = self._hash(getattr(cls, part))
         else:
             cls_hash = self._hash(cls)
-        userdata = s.qos[Policy.Userdata]
-        found = parse_user_data(userdata.data if userdata is not None else b"").get("typehash")
+        found = parse_user_data(_user_data_of(s)).get("typehash")
         if found is not None and found != cls_hash:
             if kind == "writer":
                 self._blocked.add(s.sample_info.instance_handle)
@@ -897,16 +899,29 @@ class DdsTransport(Transport):
                 err = "cancelled" if fut.cancelled() else fut.exception()
                 _log.error(f"service {service.srv_name} failed a remote request: {err}; DDS has no error reply, none is sent")
                 return
-            if side.writer.get_matched_subscriptions():
+            if self._caller_matched(side, handle):
                 self._write_reply(side, guid, seq, fut.result())  # now: before what after_reply() queued
             else:
-                loop.create_task(self._reply_when_matched(side, guid, seq, fut.result()))
+                loop.create_task(self._reply_when_matched(side, handle, guid, seq, fut.result()))
 
         future.add_done_callback(done)
         service.node._call_soon(service._enqueue, _Call(request, loop, future, guid.to_bytes(8, "little") + bytes(8), seq))
 
-    async def _reply_when_matched(self, side: _ServiceSide, guid: int, seq: int, response: Any) -> None:
-        if await _until(lambda: bool(side.writer.get_matched_subscriptions())):
+    def _caller_matched(self, side: _ServiceSide, handle: int) -> bool:
+        """The reply writer has matched the caller's reply reader: the reader with the ``clientid`` of the
+        request's writer, or any reader when that writer gave none (rmw_cyclonedds's server test)."""
+        matched = side.writer.get_matched_subscriptions()
+        clientid = self._clientids.get(handle)
+        if clientid is None or not matched:
+            return bool(matched)
+        for reader in matched:
+            data = side.writer.get_matched_subscription_data(reader)
+            if data is not None and parse_user_data(_user_data_of(data)).get("clientid") == clientid:
+                return True
+        return False
+
+    async def _reply_when_matched(self, side: _ServiceSide, handle: int, guid: int, seq: int, response: Any) -> None:
+        if await _until(lambda: self._caller_matched(side, handle)):
             self._write_reply(side, guid, seq, response)
         else:
             self._warn("reply", f"no reply reader for a request on {side.service.srv_name}: reply dropped")
@@ -989,6 +1004,14 @@ async def _until(predicate: Any) -> bool:
         await asyncio.sleep(delay)
         delay = min(delay * 2, 0.02)
     return True
+
+
+def _user_data_of(endpoint: Any) -> bytes:
+    """A discovered endpoint's USER_DATA (empty when it has none)."""
+    from cyclonedds.core import Policy
+
+    found = endpoint.qos[Policy.Userdata]
+    return found.data if found is not None else b""
 
 
 def _rename(entry: Any, node: str) -> None:
