@@ -455,6 +455,10 @@ class DdsTransport(Transport):
     # -- participant ---------------------------------------------------------------------
 
     async def open(self, bus: Bus) -> None:
+        try:
+            import cyclonedds  # noqa: F401
+        except ImportError as err:
+            raise RuntimeError(f"the dds transport needs cyclonedds (pip install 'cyclonedds>=11,<12'): {err}") from None
         config, warnings = (self.config, []) if self.config is not None else discovery_config()
         for text in warnings:
             _log.warning(text)
