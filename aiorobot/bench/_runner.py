@@ -29,6 +29,7 @@ PARTS: dict[str, str] = {
     "nav": "aiorobot.bench._nav",
     "sim": "aiorobot.bench._sim",
     "zenoh": "aiorobot.bench._zenoh",
+    "dds": "aiorobot.bench._dds",
     "fusion": "aiorobot.bench._fusion",
     "perception": "aiorobot.bench._perception",
     "demo": "aiorobot.bench._demo",

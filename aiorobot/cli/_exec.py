@@ -10,12 +10,12 @@ from ._parser import transport_name
 __all__ = ["add_arguments", "main"]
 
 
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--transport", type=transport_name, metavar="NAME", default="local",
         help="local: the program's nodes talk in-process (default); zenoh: with other processes "
-        "(ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE apply, as in rmw_zenoh)",
+        "(ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE apply, as in rmw_zenoh); dds: with ROS 2 "
+        "nodes on DDS (ROS_DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE, CYCLONEDDS_URI apply, docs/dds.md)",
     )
     parser.add_argument(
         "--node", action="append", default=[], metavar="MODULE:CLASS",

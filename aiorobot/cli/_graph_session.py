@@ -1,4 +1,4 @@
-"""What the graph commands share: joining the graph over zenoh, and messages as YAML."""
+"""What the graph commands share: joining the graph over zenoh or DDS, and messages as YAML."""
 
 from __future__ import annotations
 
@@ -66,6 +66,12 @@ def run_verb(
 
 
 def add_graph_options(parser: argparse.ArgumentParser) -> None:
+    from .._core._transport import transport_names
+
+    parser.add_argument(
+        "--transport", choices=[n for n in transport_names() if n != "local"], default="zenoh",
+        help="how to reach the graph: zenoh (rmw_zenoh's, the default) or dds (ROS 2 on DDS: docs/dds.md)",
+    )
     parser.add_argument(
         "--connect", action="append", metavar="ENDPOINT",
         help="zenoh endpoint of a router or peer (default tcp/127.0.0.1:7447, as rmw_zenoh)",
@@ -75,23 +81,33 @@ def add_graph_options(parser: argparse.ArgumentParser) -> None:
 
 @asynccontextmanager
 async def join_graph(args: argparse.Namespace) -> AsyncIterator[Any]:
-    """A runtime on the zenoh transport that has seen the graph's current tokens."""
+    """A runtime on the chosen transport (zenoh unless ``--transport``) that has seen the graph's current
+    entities (zenoh's liveliness tokens, DDS's discovery data)."""
     from .. import Runtime
-    from ..transport import ZenohTransport
+    from .._core._transport import make_transport
 
     domain = args.domain_id if args.domain_id is not None else int(os.environ.get("ROS_DOMAIN_ID", "0") or 0)
-    transport = ZenohTransport(domain_id=domain, connect=args.connect)
+    name = getattr(args, "transport", "zenoh")
+    options: dict[str, Any] = {}
+    if name == "zenoh":
+        options["connect"] = args.connect
+    elif args.connect:
+        raise UserError(f"--connect: zenoh endpoints, but --transport is {name}; DDS finds its peers itself (docs/dds.md)")
+    transport = make_transport(name, domain_id=domain, **options)
     async with Runtime(transport=transport, domain_id=domain, handle_signals=False) as rt:
         await settle_discovery(transport)
         yield rt
 
 
 async def settle_discovery(transport: Any) -> None:
+    def count() -> int:  # remote entities, and nodes (DDS names them apart from its endpoints)
+        return len(transport._remote) + len(transport.remote_nodes())
+
     start = last_change = time.monotonic()
-    seen = len(transport._remote)
+    seen = count()
     while time.monotonic() - start < DISCOVERY_MAX_SEC:
         await asyncio.sleep(0.02)
-        now_seen = len(transport._remote)
+        now_seen = count()
         if now_seen != seen:
             seen, last_change = now_seen, time.monotonic()
         elif time.monotonic() - last_change >= (QUIET_SEC if seen else EMPTY_QUIET_SEC) and not getattr(transport, "_describing", None):

@@ -82,6 +82,8 @@ def test_json_holds_every_part_model_and_kind(quick_run) -> None:
     for row in (lockstep, realtime, fifo):
         assert row["waypoints_reached"] == row["waypoints_total"] > 0 and row["collisions"] == 0, row
         assert row["perception_fps"] > 0 and row["localisation_rmse_m"] < 0.15
+    dds = doc["parts"]["dds"]  # the DDS transport and both bare cyclonedds-python pairs delivered
+    assert all(dds[k]["n"] > 0 for k in ("twist", "bare_twist", "typed_twist", "image", "bare_image", "typed_image")), dds
     for name in PARTS:
         assert "noise" in doc["parts"][name]
 
