@@ -61,7 +61,7 @@ def test_the_core_imports_the_zenoh_package_only_when_zenoh_is_asked_for() -> No
 
 
 def test_an_unknown_name_lists_the_registered_ones() -> None:
-    with pytest.raises(ValueError, match=r"^transport: expected one of 'local', .*'zenoh', found 'udp'$"):
+    with pytest.raises(ValueError, match=r"^transport: expected one of .*'local', .*'zenoh', found 'udp'$"):
         make_transport("udp")
     with pytest.raises(ValueError, match=r"^transport: expected one of .*, found 'udp'$"):
         Runtime(transport="udp")
@@ -114,7 +114,7 @@ def test_config_files_and_the_cli_accept_the_registrys_names_not_a_list_of_their
     config.write_text('[runtime]\ntransport = "recording"\n\n[[nodes]]\nuse = "aiorobot.examples:Talker"\n')
     from aiorobot._core._errors import ConfigError
 
-    with pytest.raises(ConfigError, match=r'runtime\.transport: expected "local" or "zenoh", found "recording"'):
+    with pytest.raises(ConfigError, match=r'runtime\.transport: expected .*"local".*"zenoh", found "recording"'):
         load_config(config)
     parser = ArgumentParser(prog="aiorobot exec")
     add_arguments(parser)
