@@ -165,6 +165,23 @@ class World:
         dy = np.clip(y, cy0, cy0 + res) - y
         return bool(np.all(dx * dx + dy * dy > radius * radius))
 
+    def add_obstacle(self, x: float, y: float, half_x: float, half_y: float | None = None) -> None:
+        """Put a box of half sizes ``half_x`` by ``half_y`` (m) centred at ``(x, y)`` into the world, not the map.
+
+        What a person or a pushed box is: from now on it blocks the lidar's rays and the robot,
+        while the map (``occupancy``, what the simulator publishes on ``/map``) stays as it was.
+        """
+        half_y = half_x if half_y is None else half_y
+        ox, oy, _ = self.origin
+        res = self.resolution
+        h, w = self.occupied.shape
+        c0, c1 = max(math.floor((x - half_x - ox) / res), 0), min(math.ceil((x + half_x - ox) / res), w)
+        r0, r1 = max(math.floor((y - half_y - oy) / res), 0), min(math.ceil((y + half_y - oy) / res), h)
+        if c0 >= c1 or r0 >= r1:
+            raise ValueError(f"add_obstacle: the box at ({x:g}, {y:g}) of half sizes {half_x:g} x {half_y:g} m is outside {self!r}")
+        self.occupied[r0:r1, c0:c1] = 1
+        object.__setattr__(self, "_clearance", None)  # recomputed from the new grid at the next ray cast
+
     def to_image(self) -> NDArray[np.uint8]:
         """The grid as a map_server image (top row = highest y): free 254, occupied 0, unknown 205."""
         image = np.full(self.occupancy.shape, 205, dtype=np.uint8)
