@@ -18,6 +18,7 @@ from ._costmap import (
 )
 from ._collision_monitor import ActionType, CollisionAction, CollisionMonitor, Zone
 from ._collision_monitor_node import CollisionMonitorNode, CollisionMonitorStatistics
+from ._footprint import Footprint
 from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, PlanFailure, plan
 from ._amcl_node import AmclNode
@@ -44,6 +45,7 @@ __all__ = [
     "CollisionMonitor",
     "CollisionMonitorNode",
     "CollisionMonitorStatistics",
+    "Footprint",
     "Zone",
     "AmclNode",
     "LandmarkFixNode",

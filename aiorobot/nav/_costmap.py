@@ -13,15 +13,24 @@ lethal, the cells along each beam cleared), and inflation with Nav2's cost funct
     distance <= inflation_radius      -> (INSCRIBED - 1) * exp(-cost_scaling_factor * (distance - inscribed_radius))
 
 with ``distance`` the Euclidean distance between cell centres (InflationLayer::computeCost).
+
+The robot's shape is a :class:`~aiorobot.nav.Footprint` (Nav2's ``footprint`` polygon or
+``robot_radius``): its inscribed radius is inflation's ``inscribed_radius``, and
+:meth:`Costmap.in_collision` checks a pose with it. Costmap filters (keepout masks) are applied
+after inflation, as Nav2's filters are.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from ._footprint import Footprint
 
 __all__ = [
     "FREE_SPACE",
@@ -53,7 +62,8 @@ class Costmap:
     """A 2D costmap: ``cost`` (H, W) uint8, ``resolution`` (m/cell), ``origin`` (x, y) of cell (0, 0)'s corner.
 
     Parameters as Nav2's: ``robot_radius`` (inscribed radius of a round footprint),
-    ``inflation_radius``, ``cost_scaling_factor``.
+    ``inflation_radius``, ``cost_scaling_factor``. A ``footprint`` (a :class:`Footprint`) sets
+    ``robot_radius`` to its inscribed radius; without one the robot is the disc of ``robot_radius``.
     """
 
     static: NDArray[np.uint8]
@@ -62,8 +72,15 @@ class Costmap:
     robot_radius: float = 0.22
     inflation_radius: float = 0.55
     cost_scaling_factor: float = 3.0
+    footprint: Footprint | None = None
 
     def __post_init__(self) -> None:
+        from ._footprint import Footprint
+
+        if self.footprint is None:
+            self.footprint = Footprint.circle(self.robot_radius)
+        else:
+            self.robot_radius = self.footprint.inscribed_radius
         self.static = np.ascontiguousarray(self.static, dtype=np.uint8)
         if self.static.ndim != 2 or min(self.static.shape) < 1:
             raise ValueError(f"costmap: expected a (H, W) grid, got shape {self.static.shape}")
@@ -108,6 +125,32 @@ class Costmap:
         """Cost of the cell under (x, y); NO_INFORMATION outside the map."""
         r, c = self.world_to_cell(x, y)
         return int(self.cost[r, c]) if self.in_bounds(r, c) else NO_INFORMATION
+
+    def footprint_cost(self, x: float, y: float, yaw: float) -> int:
+        """Nav2's ``footprintCostAtPose``: the highest cost along the footprint's outline at (x, y, yaw)."""
+        from ._footprint import footprint_cost
+
+        assert self.footprint is not None
+        return footprint_cost(self.cost, self.footprint.at(x, y, yaw), self.origin, self.resolution)
+
+    def in_collision(self, x: float, y: float, yaw: float, *, allow_unknown: bool = True) -> bool:
+        """Whether the robot at (x, y, yaw) touches an obstacle.
+
+        A round robot: its centre cell is INSCRIBED or LETHAL (an obstacle within the radius).
+        A polygon: that, or a LETHAL cell on its outline (Nav2's RPP check). Unknown space counts
+        as free with ``allow_unknown`` (Nav2's track_unknown_space), else as an obstacle.
+        """
+        centre = self.cost_at(x, y)
+        if centre == NO_INFORMATION:
+            if not allow_unknown:
+                return True
+        elif centre >= INSCRIBED_INFLATED_OBSTACLE:
+            return True
+        assert self.footprint is not None
+        if self.footprint.is_circular:
+            return False
+        outline = self.footprint_cost(x, y, yaw)
+        return outline == LETHAL_OBSTACLE or (outline == NO_INFORMATION and not allow_unknown)
 
     def clear_obstacles(self) -> None:
         self.obstacles[:] = 0

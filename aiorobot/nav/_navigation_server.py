@@ -6,6 +6,10 @@ inflation), reads the robot pose from tf (``global_frame`` -> ``robot_base_frame
 replans every ``replan_period`` (Nav2's default behaviour tree replans at 1 Hz), follows the path
 with RPP at ``controller_frequency`` and publishes ``/cmd_vel`` and ``/plan``.
 
+The robot's shape is Nav2's costmap parameters ``footprint`` (a polygon ``"[[x, y], ...]"``, padded
+by ``footprint_padding``) or ``robot_radius``: the costmap inflates by its inscribed radius, and the
+planner and RPP's collision check test the footprint at each pose.
+
 When blocked (collision ahead, no progress within ``movement_time_allowance``, no path) it runs
 Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle layer and replan,
 wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason. A goal outside the
@@ -127,8 +131,16 @@ class NavigationServer(Node):
         self.max_localization_std = float(d("max_localization_std", 0.5).value)
         self.max_localization_yaw_std = float(d("max_localization_yaw_std", 0.8).value)
         self.localization_recovery_timeout = float(d("localization_recovery_timeout", 5.0).value)
+        from ._footprint import Footprint
+
+        robot_radius = float(d("robot_radius", 0.22).value)
+        try:  # Nav2's costmap parameters: a footprint polygon wins over robot_radius
+            footprint = Footprint.from_parameters(d("footprint", "[]").value, robot_radius, float(d("footprint_padding", 0.01).value))
+        except ValueError as err:
+            raise ValueError(f"{self.get_name()}: {err}") from None
         self.costmap_params = {
-            "robot_radius": float(d("robot_radius", 0.22).value),
+            "footprint": footprint,
+            "robot_radius": robot_radius,
             "inflation_radius": float(d("inflation_radius", 0.55).value),
             "cost_scaling_factor": float(d("cost_scaling_factor", 3.0).value),
         }

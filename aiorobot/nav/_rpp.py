@@ -14,8 +14,8 @@ Same parameters and regulation functions (``regulation_functions.hpp``):
 - rotate to heading: when the carrot is more than ``rotate_to_heading_min_angle`` off the heading
   (and at the goal, to the goal's yaw) the base turns in place at ``rotate_to_heading_angular_vel``;
 - collision detection: the commanded arc is projected forward for up to
-  ``max_allowed_time_to_collision_up_to_carrot``; a lethal/inscribed cell on it stops the base and
-  sets ``collision_ahead``.
+  ``max_allowed_time_to_collision_up_to_carrot``; the costmap's footprint touching an obstacle at a
+  pose on it (:meth:`Costmap.in_collision`) stops the base and sets ``collision_ahead``.
 """
 
 from __future__ import annotations
@@ -230,7 +230,6 @@ class RegulatedPurePursuit:
             x += linear * math.cos(th) * dt
             y += linear * math.sin(th) * dt
             th += angular * dt
-            c = self.costmap.cost_at(x, y)
-            if INSCRIBED_INFLATED_OBSTACLE <= c < NO_INFORMATION:
+            if self.costmap.in_collision(x, y, th):  # the costmap's footprint at each pose of the arc
                 return True
         return False
