@@ -5,10 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from aiorobot import load_config
-from aiorobot.demo._graph import GRAPH_FILE, build_graph
+from aiorobot.demo._graph import GRAPH_FILE, ROBOT_RADIUS, build_graph
 from aiorobot.sim import World
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fusion_ekf.toml"
@@ -40,6 +41,8 @@ def test_the_options_pick_the_graph_files_nodes_and_add_the_runs_parameters(loca
     assert graph.server.cmd_pub.topic_name == "/cmd_vel_nav" and graph.collision_monitor.cmd_pub.topic_name == "/cmd_vel"
     sim = graph.simulator
     assert sim.get_parameter("world").value == str(world.path) and sim.get_parameter("seed").value == 3
+    # a rectangular base inside the disc the navigation server and the start checks use
+    assert sim.body.footprint is not None and np.hypot(*sim.body.footprint.T).max() <= ROBOT_RADIUS
     assert sim.get_parameter("camera_rate").value == (15.0 if perception else 0.0)
     if localisation == "landmarks":
         ekf_global = graph.nodes[3][0]
