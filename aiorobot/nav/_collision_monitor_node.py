@@ -147,12 +147,9 @@ class CollisionMonitorNode(Node):
     # -- configuration -------------------------------------------------------------------
 
     def _names(self, key: str) -> list[str]:
-        from aiorobot import Parameter, ParameterUninitializedError
+        from aiorobot import Parameter
 
-        try:
-            names = list(self.declare_parameter(key, Parameter.Type.STRING_ARRAY).value)
-        except ParameterUninitializedError:
-            names = []
+        names = list(self.declare_parameter(key, Parameter.Type.STRING_ARRAY).value or [])
         if not names:
             raise ValueError(f"{self.get_name()}: parameter {key}: expected a list of names (as nav2_collision_monitor), found none")
         return names

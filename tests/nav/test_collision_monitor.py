@@ -110,13 +110,15 @@ def test_points_parse_from_nav2_string_or_flat_array_with_clear_errors() -> None
 
 
 def _params(**extra: object) -> dict[str, object]:
-    return {"polygons": ["PolygonStop"], "PolygonStop.type": "polygon", "PolygonStop.action_type": "stop",
+    params = {"polygons": ["PolygonStop"], "PolygonStop.type": "polygon", "PolygonStop.action_type": "stop",
             "PolygonStop.points": "[[0.4, 0.3], [0.4, -0.3], [0.0, -0.3], [0.0, 0.3]]", "PolygonStop.min_points": 2,
             "observation_sources": ["scan"], "scan.type": "scan", "scan.topic": "scan", **extra}
+    return {k: v for k, v in params.items() if v is not None}  # None: leave the parameter out
 
 
 @pytest.mark.parametrize(("extra", "message"), [
     ({"polygons": []}, r"^collision_monitor: parameter polygons: expected a list of names \(as nav2_collision_monitor\), found none$"),
+    ({"observation_sources": None}, r"^collision_monitor: parameter observation_sources: expected a list of names"),
     ({"PolygonStop.action_type": "halt"},
      r"^collision_monitor: parameter PolygonStop\.action_type: expected one of stop, slowdown, limit, approach, none, found 'halt'$"),
     ({"PolygonStop.type": "velocity_polygon"},
