@@ -34,6 +34,25 @@ def monitor_parameters(**extra: Any) -> dict[str, Any]:
     }
 
 
+def send_map_to_odom(node: Node) -> None:
+    """map -> odom at the start pose: with exact odometry (see :func:`simulator`) tf's base_link is the truth."""
+    from aiorobot.msgs.geometry_msgs import TransformStamped
+    from aiorobot.tf import StaticTransformBroadcaster
+
+    t = TransformStamped()
+    t.header.frame_id, t.child_frame_id = "map", "odom"
+    t.transform.translation.x, t.transform.translation.y = START[0], START[1]
+    t.transform.rotation.w = 1.0
+    StaticTransformBroadcaster(node).send_transform(t)
+
+
+def simulator(seed: int) -> Simulator:
+    """The box world in lock-step, exact odometry broadcast on tf, no camera."""
+    return Simulator(parameter_overrides={
+        "world": "box", "start": list(START), "real_time_factor": 0.0, "seed": seed, "publish_odom_tf": True,
+        "odom_scale_error": 0.0, "odom_noise_std": 0.0, "camera_rate": 0.0, "robot_radius": ROBOT_RADIUS})
+
+
 class Pusher(Node):
     """Pushes a box into the robot's path, 1 m ahead of it, once it drives at speed; watches the gap."""
 
@@ -41,8 +60,6 @@ class Pusher(Node):
         super().__init__("pusher")
         from aiorobot.msgs.nav2_msgs import CollisionMonitorState
         from aiorobot.msgs.nav_msgs import Odometry
-        from aiorobot.tf import StaticTransformBroadcaster
-        from aiorobot.msgs.geometry_msgs import TransformStamped
 
         self.sim, self.push_at_x = sim, push_at_x
         self.box_x: float | None = None
@@ -52,11 +69,7 @@ class Pusher(Node):
         self.stopped_gap: float | None = None  # that gap when the robot first stood still after the push
         self.stopped_at: float | None = None
         self.states: list[tuple[int, str]] = []
-        t = TransformStamped()
-        t.header.frame_id, t.child_frame_id = "map", "odom"
-        t.transform.translation.x, t.transform.translation.y = START[0], START[1]
-        t.transform.rotation.w = 1.0
-        StaticTransformBroadcaster(self).send_transform(t)
+        send_map_to_odom(self)
         self.create_subscription(Odometry, "/ground_truth/odom", self._on_truth, 10)
         self.create_subscription(CollisionMonitorState, "/collision_monitor_state",
                                  lambda m: self.states.append((int(m.action_type), str(m.polygon_name))), 10)
@@ -81,9 +94,7 @@ class Pusher(Node):
 
 async def _run(seed: int) -> tuple[Simulator, Pusher, CollisionMonitorNode]:
     async with Runtime(use_sim_time=True, handle_signals=False) as rt:
-        sim = Simulator(parameter_overrides={
-            "world": "box", "start": list(START), "real_time_factor": 0.0, "seed": seed, "publish_odom_tf": True,
-            "odom_scale_error": 0.0, "odom_noise_std": 0.0, "camera_rate": 0.0, "robot_radius": ROBOT_RADIUS})
+        sim = simulator(seed)
         rt.add_node(NavigationServer(parameter_overrides={"use_collision_detection": False, "replan_period": 30.0,
                                                           "desired_linear_vel": 0.5,
                                                           "localization_topic": ""},
