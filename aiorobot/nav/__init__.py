@@ -18,6 +18,7 @@ from ._costmap import (
 )
 from ._collision_monitor import ActionType, CollisionAction, CollisionMonitor, Zone
 from ._collision_monitor_node import CollisionMonitorNode, CollisionMonitorStatistics
+from ._filters import NO_SPEED_LIMIT, FilterType, SpeedLimitFilter, keepout_layer, mask_cost
 from ._footprint import Footprint
 from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, PlanFailure, plan
@@ -46,6 +47,11 @@ __all__ = [
     "CollisionMonitorNode",
     "CollisionMonitorStatistics",
     "Footprint",
+    "FilterType",
+    "NO_SPEED_LIMIT",
+    "SpeedLimitFilter",
+    "keepout_layer",
+    "mask_cost",
     "Zone",
     "AmclNode",
     "LandmarkFixNode",

@@ -16,8 +16,10 @@ with ``distance`` the Euclidean distance between cell centres (InflationLayer::c
 
 The robot's shape is a :class:`~aiorobot.nav.Footprint` (Nav2's ``footprint`` polygon or
 ``robot_radius``): its inscribed radius is inflation's ``inscribed_radius``, and
-:meth:`Costmap.in_collision` checks a pose with it. Costmap filters (keepout masks) are applied
-after inflation, as Nav2's filters are.
+:meth:`Costmap.in_collision` checks a pose with it. A keepout filter's mask (Nav2's
+KeepoutFilter costs) is merged into the static layer before inflation, unlike Nav2, which applies
+filters after it: a keepout zone then keeps the robot's body out, not only its centre, and the
+controller's collision check does not stop the robot on a path hugging the zone's edge.
 """
 
 from __future__ import annotations
@@ -90,6 +92,8 @@ class Costmap:
             raise ValueError(
                 f"costmap: inflation_radius ({self.inflation_radius}) must be >= robot_radius ({self.robot_radius}), as in Nav2"
             )
+        #: the keepout filter's costs on this grid (NO_INFORMATION: no say), merged into the static layer
+        self.keepout: NDArray[np.uint8] | None = None
         self.obstacles = np.zeros_like(self.static)
         self.cost = np.empty_like(self.static)
         self._static_cost: NDArray[np.uint8] | None = None
@@ -176,7 +180,7 @@ class Costmap:
         update only inflates the obstacle layer, inside the window its marks can reach.
         """
         if self._static_cost is None or self._static_cost.shape != self.static.shape:
-            self._static_cost = self._inflate(self.static)
+            self._static_cost = self._inflate(self._with_keepout(self.static))
         cost = self._static_cost.copy()
         marks = np.argwhere(self.obstacles == LETHAL_OBSTACLE)
         if len(marks):
@@ -190,6 +194,27 @@ class Costmap:
             merged[self.obstacles[r0:r1, c0:c1] == LETHAL_OBSTACLE] = LETHAL_OBSTACLE  # ...unless an obstacle was seen there
             cost[r0:r1, c0:c1] = merged
         self.cost = cost
+
+    def _with_keepout(self, layer: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """``layer`` under the keepout filter: Nav2's KeepoutFilter rule, a mask cost replaces a lower or unknown one."""
+        if self.keepout is None:
+            return layer
+        out = layer.copy()
+        k = self.keepout
+        take = (k != NO_INFORMATION) & ((k > out) | (out == NO_INFORMATION))
+        out[take] = k[take]
+        return out
+
+    def set_keepout(self, layer: NDArray[np.uint8] | None) -> None:
+        """Install (or with None remove) a keepout filter layer (H, W) of costs, see
+        :func:`~aiorobot.nav.keepout_layer`, and recompute the costs."""
+        if layer is not None:
+            layer = np.ascontiguousarray(layer, dtype=np.uint8)
+            if layer.shape != self.static.shape:
+                raise ValueError(f"set_keepout: expected a layer of the costmap's shape {self.static.shape}, found {layer.shape}")
+        self.keepout = layer
+        self._static_cost = None
+        self.update()
 
     def _inflate(self, layer: NDArray[np.uint8]) -> NDArray[np.uint8]:
         """``layer`` with its lethal cells inflated (cells outside ``inflation_radius`` keep their value)."""

@@ -10,6 +10,10 @@ The robot's shape is Nav2's costmap parameters ``footprint`` (a polygon ``"[[x, 
 by ``footprint_padding``) or ``robot_radius``: the costmap inflates by its inscribed radius, and the
 planner and RPP's collision check test the footprint at each pose.
 
+Costmap filters as Nav2's (``filters``, each with its ``plugin`` and ``filter_info_topic``): a
+keepout mask makes its cells obstacles for the planner, a speed mask caps RPP's speed where the
+robot is (see :mod:`aiorobot.nav._filter_inputs`).
+
 When blocked (collision ahead, no progress within ``movement_time_allowance``, no path) it runs
 Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle layer and replan,
 wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason. A goal outside the
@@ -38,6 +42,7 @@ from .._core._node import Node
 from .._core._warm_up import compile_kernels
 from .._core._qos import QoSProfile, ReliabilityPolicy
 from ._costmap import Costmap
+from ._filter_inputs import FilterInputs
 from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
@@ -165,6 +170,7 @@ class NavigationServer(Node):
         #: why the last pose estimate counts as lost (None: fine, or no estimate seen)
         self.localization_lost: str | None = None
         self._subscribe_localization()
+        self.filters = FilterInputs(self)  # Nav2's costmap filters: keepout (planner) and speed (controller)
         self._busy = False
         from ._kernels import warm_up
 
@@ -186,6 +192,7 @@ class NavigationServer(Node):
         self.map = OccupancyMap.from_msg(msg)
         self.costmap = Costmap.from_occupancy(self.map.data, self.map.width, self.map.height, self.map.resolution,
                                               self.map.origin[:2], **self.costmap_params)
+        self.filters.attach(self.costmap)
 
     def _subscribe_localization(self) -> None:
         from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
@@ -441,6 +448,7 @@ class NavigationServer(Node):
                     continue
                 first_plan = False
                 last_plan_at = t
+            self.filters.limit_speed(rpp, pose[0], pose[1])
             cmd = rpp.step(pose, speed)
             if cmd.goal_reached:
                 self._stop_base()

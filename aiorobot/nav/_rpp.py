@@ -101,6 +101,16 @@ class RegulatedPurePursuit:
         self.path: NDArray[np.float64] = np.zeros((0, 3))
         self._last_angular = 0.0
         self._progress = 0
+        #: the speed the regulation starts from: ``desired_linear_vel`` unless a speed limit holds
+        self.desired_linear_vel = self.p.desired_linear_vel
+
+    def set_speed_limit(self, speed_limit: float, percentage: bool) -> None:
+        """Nav2's ``setSpeedLimit``: cap the speed at ``speed_limit`` (percent of ``desired_linear_vel``
+        or m/s); 0.0 (NO_SPEED_LIMIT) lifts the cap."""
+        from ._filters import limited_speed
+
+        # unlike Nav2's RPP, an absolute limit above desired_linear_vel does not raise the speed: a limit only limits
+        self.desired_linear_vel = min(limited_speed(self.p.desired_linear_vel, speed_limit, percentage), self.p.desired_linear_vel)
 
     def set_plan(self, poses: NDArray[np.float64]) -> None:
         poses = np.asarray(poses, dtype=np.float64)
@@ -186,7 +196,7 @@ class RegulatedPurePursuit:
 
     def _regulate(self, curvature: float, xy: tuple[float, float], remaining: float) -> float:
         p = self.p
-        raw = p.desired_linear_vel
+        raw = self.desired_linear_vel
         curv_vel = raw
         if p.use_regulated_linear_velocity_scaling and abs(curvature) > 1e-9:
             radius = abs(1.0 / curvature)
@@ -204,7 +214,7 @@ class RegulatedPurePursuit:
         if remaining < p.approach_velocity_scaling_dist:
             scaled = raw * remaining / p.approach_velocity_scaling_dist
             linear = min(linear, max(scaled, p.min_approach_linear_velocity))
-        return min(linear, p.desired_linear_vel)
+        return min(linear, raw)
 
     def _rotate(self, angle: float, carrot: tuple[float, float], lookahead: float = 0.0) -> RppCommand:
         p = self.p
