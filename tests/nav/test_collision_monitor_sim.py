@@ -12,6 +12,7 @@ import asyncio
 import math
 from typing import Any
 
+import numpy as np
 import pytest
 
 from aiorobot import Node, Runtime
@@ -54,14 +55,15 @@ def simulator(seed: int) -> Simulator:
 
 
 class Pusher(Node):
-    """Pushes a box into the robot's path, 1 m ahead of it, once it drives at speed; watches the gap."""
+    """Pushes a box into the robot's path, 1 m ahead of it (``offset_y`` to the side), once it drives at
+    speed; watches the gap."""
 
-    def __init__(self, sim: Simulator, push_at_x: float) -> None:
+    def __init__(self, sim: Simulator, push_at_x: float, offset_y: float) -> None:
         super().__init__("pusher")
         from aiorobot.msgs.nav2_msgs import CollisionMonitorState
         from aiorobot.msgs.nav_msgs import Odometry
 
-        self.sim, self.push_at_x = sim, push_at_x
+        self.sim, self.push_at_x, self.offset_y = sim, push_at_x, offset_y
         self.box_x: float | None = None
         self.box_y = 0.0
         self.pushed_at: float | None = None
@@ -79,9 +81,9 @@ class Pusher(Node):
         speed = math.hypot(msg.twist.twist.linear.x, msg.twist.twist.linear.y)
         if self.box_x is None:
             if x >= self.push_at_x and speed > 0.4:
-                self.box_x, self.box_y = x + 1.0, y
+                self.box_x, self.box_y = x + 1.0, y + self.offset_y
                 self.pushed_at = self.sim.time_ns / 1e9
-                self.sim.world.add_obstacle(self.box_x, y, BOX_HALF)
+                self.sim.world.add_obstacle(self.box_x, self.box_y, BOX_HALF)
             return
         dx = max(abs(x - self.box_x) - BOX_HALF, 0.0)
         dy = max(abs(y - self.box_y) - BOX_HALF, 0.0)
@@ -100,7 +102,8 @@ async def _run(seed: int) -> tuple[Simulator, Pusher, CollisionMonitorNode]:
                                                           "localization_topic": ""},
                                      remappings={"/cmd_vel": "/cmd_vel_nav"}))
         monitor = rt.add_node(CollisionMonitorNode(parameter_overrides=monitor_parameters()), executor="priority")
-        pusher = rt.add_node(Pusher(sim, push_at_x=-1.4 + 0.1 * (seed % 3)))
+        rng = np.random.default_rng(seed)  # where the box comes in: along the route, and across it within its width
+        pusher = rt.add_node(Pusher(sim, push_at_x=float(rng.uniform(-1.5, -1.0)), offset_y=float(rng.uniform(-0.15, 0.15))))
         nav = rt.add_node(Navigator())
         rt.add_node(sim)
         assert await nav.go_to_pose(pose_stamped(2.5, 0.0, 0.0))
