@@ -92,7 +92,11 @@ class _Source:
 
 
 class CollisionMonitorNode(Node):
-    """nav2_collision_monitor's node (see the module doc for parameters and differences)."""
+    """nav2_collision_monitor's node (see the module doc for parameters and differences).
+
+    rclpy difference: it also acts on new sensor data between commands (lowering only), and
+    velocity / dynamic polygons and range / polygon / costmap sources are not implemented.
+    """
 
     def __init__(self, node_name: str = "collision_monitor", **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)

@@ -106,10 +106,12 @@ class RegulatedPurePursuit:
 
     def set_speed_limit(self, speed_limit: float, percentage: bool) -> None:
         """Nav2's ``setSpeedLimit``: cap the speed at ``speed_limit`` (percent of ``desired_linear_vel``
-        or m/s); 0.0 (NO_SPEED_LIMIT) lifts the cap."""
+        or m/s); 0.0 (NO_SPEED_LIMIT) lifts the cap.
+
+        rclpy difference: an absolute limit above ``desired_linear_vel`` does not raise the speed.
+        """
         from ._filters import limited_speed
 
-        # unlike Nav2's RPP, an absolute limit above desired_linear_vel does not raise the speed: a limit only limits
         self.desired_linear_vel = min(limited_speed(self.p.desired_linear_vel, speed_limit, percentage), self.p.desired_linear_vel)
 
     def set_plan(self, poses: NDArray[np.float64]) -> None:
