@@ -196,3 +196,47 @@ async def test_node_forwards_stops_on_a_new_scan_between_commands_and_reports_it
         assert h.states[-1] == (1, "PolygonStop")
         stats = node.statistics()
         assert stats.sensor_triggered == 1 and stats.action_type == ActionType.STOP and stats.polygon_name == "PolygonStop"
+
+
+async def test_pointcloud_source_keeps_points_between_min_and_max_height_and_the_toggle_turns_the_monitor_off() -> None:
+    from aiorobot.msgs.geometry_msgs import PolygonStamped
+    from aiorobot.msgs.nav2_msgs import Toggle
+    from aiorobot.msgs.point_cloud2 import create_cloud_xyz32
+    from aiorobot.msgs.sensor_msgs import PointCloud2
+    from aiorobot.msgs.std_msgs import Header
+
+    params = _params(observation_sources=["cloud"], **{"scan.type": None, "scan.topic": None}, base_shift_correction=False,
+                     **{"cloud.type": "pointcloud", "cloud.topic": "points", "cloud.min_height": 0.1, "cloud.max_height": 0.5,
+                        "PolygonStop.visualize": True, "PolygonStop.polygon_pub_topic": "polygon_stop"})
+    async with Runtime(handle_signals=False) as rt:
+        node = rt.add_node(CollisionMonitorNode(parameter_overrides=params))
+        h = rt.add_node(_Harness())
+        polygons: list[PolygonStamped] = []
+        h.create_subscription(PolygonStamped, "polygon_stop", polygons.append, 1)
+        cloud_pub = h.create_publisher(PointCloud2, "points", 5)
+        toggle = h.create_client(Toggle, "/collision_monitor/toggle")
+
+        async def until(cond: object) -> None:
+            for _ in range(500):
+                await rt.settle()
+                if cond():  # type: ignore[operator]
+                    return
+            raise AssertionError("timed out")
+
+        def cloud(z: float) -> None:
+            header = Header(frame_id="laser", stamp=h.now().to_msg())  # 0.1 m ahead of the base
+            cloud_pub.publish(create_cloud_xyz32(header, [[0.15, 0.0, z], [0.15, 0.05, z], [0.2, 0.0, z], [0.2, 0.05, z]]))
+
+        cloud(1.0)  # above max_height: an overhang the base passes under
+        await until(lambda: node.sources[0].points is not None)
+        h.cmd(0.5)
+        await until(lambda: h.out and h.out[-1] == (0.5, 0.1))
+        cloud(0.2)
+        await until(lambda: h.out[-1] == (0.0, 0.0))
+        assert node.statistics().polygon_name == "PolygonStop" and polygons and polygons[-1].header.frame_id == "base_footprint"
+        assert len(polygons[-1].polygon.points) == 4
+        assert await toggle.wait_for_service(timeout_sec=5.0)
+        response = await toggle.call_async(Toggle.Request(enable=False))
+        assert response.success and response.message == "Collision monitor toggled off successfully"
+        h.cmd(0.5)
+        await until(lambda: h.out[-1] == (0.5, 0.1))
