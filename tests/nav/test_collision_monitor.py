@@ -7,6 +7,8 @@ in our own numbers: stop, slowdown, limit and approach zones, their order, min_p
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -133,6 +135,19 @@ def test_bad_configuration_is_one_line_naming_the_parameter(extra: dict[str, obj
         CollisionMonitorNode(parameter_overrides=_params(**extra))
 
 
+def _settling(rt: Runtime) -> Any:
+    """``await until(cond)``: let the runtime settle until ``cond()`` holds (500 rounds at most)."""
+
+    async def until(cond: Callable[[], object]) -> None:
+        for _ in range(500):
+            await rt.settle()
+            if cond():
+                return
+        raise AssertionError("timed out")
+
+    return until
+
+
 class _Harness(Node):
     def __init__(self) -> None:
         super().__init__("harness")
@@ -175,13 +190,7 @@ async def test_node_forwards_stops_on_a_new_scan_between_commands_and_reports_it
         node = rt.add_node(CollisionMonitorNode(parameter_overrides=_params(state_topic="collision_monitor_state",
                                                                             base_shift_correction=False)))
         h = rt.add_node(_Harness())
-
-        async def until(cond: object) -> None:
-            for _ in range(500):
-                await rt.settle()
-                if cond():  # type: ignore[operator]
-                    return
-            raise AssertionError("timed out")
+        until = _settling(rt)
 
         h.cmd(0.5)  # no scan yet: an invalid source stops the base (Nav2: a standing base gets no zero command)
         await until(lambda: h.states)
@@ -215,13 +224,7 @@ async def test_pointcloud_source_keeps_points_between_min_and_max_height_and_the
         h.create_subscription(PolygonStamped, "polygon_stop", polygons.append, 1)
         cloud_pub = h.create_publisher(PointCloud2, "points", 5)
         toggle = h.create_client(Toggle, "/collision_monitor/toggle")
-
-        async def until(cond: object) -> None:
-            for _ in range(500):
-                await rt.settle()
-                if cond():  # type: ignore[operator]
-                    return
-            raise AssertionError("timed out")
+        until = _settling(rt)
 
         def cloud(z: float) -> None:
             header = Header(frame_id="laser", stamp=h.now().to_msg())  # 0.1 m ahead of the base
