@@ -3,13 +3,16 @@
 Parameters as a Nav2 costmap's::
 
     filters: ["keepout_filter", "speed_filter"]
-    keepout_filter: {plugin: "nav2_costmap_2d::KeepoutFilter", filter_info_topic: "keepout_filter_info"}
+    keepout_filter: {plugin: "nav2_costmap_2d::KeepoutFilter", filter_info_topic: "keepout_filter_info",
+                     override_lethal_cost: true, lethal_override_cost: 200}
     speed_filter: {plugin: "nav2_costmap_2d::SpeedFilter", filter_info_topic: "speed_filter_info",
                    speed_limit_topic: "speed_limit"}
 
 Each filter subscribes to its nav2_msgs/CostmapFilterInfo (transient local, as Nav2's
 costmap_filter_info_server publishes it), then to the OccupancyGrid mask the info names. The
-keepout mask goes into the costmap as a layer (:meth:`Costmap.set_keepout`); the speed filter
+keepout mask goes into the costmap as a layer (:meth:`Costmap.set_keepout`); with
+``override_lethal_cost``, while the robot stands in a lethal part of the zone the zone's cells cost
+``lethal_override_cost`` instead (at most 252), so it can plan its way out (Nav2's). The speed filter
 gives the limit at the robot's position and publishes a nav2_msgs/SpeedLimit when it changes.
 """
 
@@ -17,8 +20,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._costmap import Costmap
-from ._filters import NO_SPEED_LIMIT, FilterType, SpeedLimitFilter, keepout_layer
+from ._costmap import FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION, Costmap
+from ._filters import NO_SPEED_LIMIT, FilterType, SpeedLimitFilter, keepout_cost_at, keepout_layer
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
 
@@ -26,6 +29,10 @@ __all__ = ["FilterInputs"]
 
 _PLUGINS = {"nav2_costmap_2d::KeepoutFilter": (FilterType.KEEPOUT_FILTER,),
             "nav2_costmap_2d::SpeedFilter": (FilterType.SPEED_FILTER_PERCENT, FilterType.SPEED_FILTER_ABSOLUTE)}
+
+
+#: nav2_costmap_2d's MAX_NON_OBSTACLE: the highest cost that is not an obstacle
+_MAX_NON_OBSTACLE = 252
 
 
 class FilterInputs:
@@ -42,6 +49,10 @@ class FilterInputs:
         self._speed_pub: Any = None
         self._last_limit: float | None = None
         self._mask_topics: dict[str, str] = {}
+        self.override_lethal_cost = False
+        self.lethal_override_cost = _MAX_NON_OBSTACLE
+        #: the robot stands in a lethal part of the keepout zone (its cells cost lethal_override_cost meanwhile)
+        self.pose_lethal = False
         names = list(node.declare_parameter("filters", Parameter.Type.STRING_ARRAY).value or [])
         for name in names:
             plugin = str(node.declare_parameter(f"{name}.plugin", "").value)
@@ -52,6 +63,10 @@ class FilterInputs:
                 raise ValueError(f"{node.get_name()}: parameter {name}.filter_info_topic: expected the CostmapFilterInfo topic, found none")
             if not bool(node.declare_parameter(f"{name}.enabled", True).value):
                 continue
+            if plugin.endswith("KeepoutFilter"):
+                self.override_lethal_cost = bool(node.declare_parameter(f"{name}.override_lethal_cost", False).value)
+                cost = int(node.declare_parameter(f"{name}.lethal_override_cost", _MAX_NON_OBSTACLE).value)
+                self.lethal_override_cost = min(max(cost, FREE_SPACE), _MAX_NON_OBSTACLE)  # clamped, as Nav2
             if plugin.endswith("SpeedFilter"):
                 self._speed_pub = node.create_publisher(SpeedLimit, str(node.declare_parameter(f"{name}.speed_limit_topic", "speed_limit").value), 1)
             node.create_subscription(CostmapFilterInfo, topic, lambda m, n=name, p=plugin: self._on_info(n, p, m), MAP_QOS)
@@ -60,12 +75,24 @@ class FilterInputs:
         """The node's (new) costmap: the keepout layer goes into it."""
         self.costmap = costmap
         if self.keepout is not None:
-            costmap.set_keepout(keepout_layer(costmap, self.keepout))
+            layer = keepout_layer(costmap, self.keepout)
+            if self.pose_lethal:
+                layer[(layer != NO_INFORMATION) & (layer > 0)] = self.lethal_override_cost  # every zone cell, as Nav2
+            costmap.set_keepout(layer)
 
-    def limit_speed(self, controller: Any, x: float, y: float) -> None:
-        """Give ``controller`` (Nav2's ``setSpeedLimit``) the speed filter's limit at (x, y)."""
+    def update(self, controller: Any, x: float, y: float) -> None:
+        """The robot is at (x, y): give ``controller`` (Nav2's ``setSpeedLimit``) the speed filter's limit
+        there, and with ``override_lethal_cost`` lower the keepout zone while the robot stands in it."""
         limit = self.speed_limit_at(x, y)
         controller.set_speed_limit(limit, self.speed.percentage if self.speed is not None else False)
+        if self.override_lethal_cost and self.keepout is not None:
+            lethal = int(keepout_cost_at(self.keepout, x, y)) >= INSCRIBED_INFLATED_OBSTACLE
+            if lethal != self.pose_lethal:
+                self.pose_lethal = lethal
+                if lethal:
+                    self.node.get_logger().warning("KeepoutFilter: Pose is in keepout zone, reducing cost override to navigate out.")
+                if self.costmap is not None:
+                    self.attach(self.costmap)
 
     def speed_limit_at(self, x: float, y: float) -> float:
         """The speed filter's limit at (x, y) (NO_SPEED_LIMIT without one), published when it changes."""

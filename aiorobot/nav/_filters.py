@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from ._costmap import LETHAL_OBSTACLE, NO_INFORMATION, Costmap
 from ._maps import OccupancyMap
 
-__all__ = ["NO_SPEED_LIMIT", "FilterType", "SpeedLimitFilter", "keepout_layer", "limited_speed", "mask_cost"]
+__all__ = ["NO_SPEED_LIMIT", "FilterType", "SpeedLimitFilter", "keepout_cost_at", "keepout_layer", "limited_speed", "mask_cost"]
 
 #: nav2_costmap_2d's NO_SPEED_LIMIT: a speed limit of 0.0 means none
 NO_SPEED_LIMIT = 0.0
@@ -70,6 +70,12 @@ def keepout_layer(costmap: Costmap, mask: OccupancyMap) -> NDArray[np.uint8]:
     y = costmap.origin[1] + (rows + 0.5) * costmap.resolution
     values = _mask_values(mask, x, y)
     return mask_cost(np.where(values < -1, -1, values).astype(np.int8))
+
+
+def keepout_cost_at(mask: OccupancyMap, x: float, y: float) -> int:
+    """The keepout mask's cost at world point (x, y) (NO_INFORMATION off the mask or unknown)."""
+    value = int(_mask_values(mask, np.array([x]), np.array([y]))[0])
+    return int(mask_cost(np.array([max(value, -1)], np.int8))[0])
 
 
 @dataclass(frozen=True)

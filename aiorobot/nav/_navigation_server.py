@@ -448,7 +448,7 @@ class NavigationServer(Node):
                     continue
                 first_plan = False
                 last_plan_at = t
-            self.filters.limit_speed(rpp, pose[0], pose[1])
+            self.filters.update(rpp, pose[0], pose[1])
             cmd = rpp.step(pose, speed)
             if cmd.goal_reached:
                 self._stop_base()

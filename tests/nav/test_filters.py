@@ -140,3 +140,38 @@ async def test_navigation_server_routes_around_a_keepout_zone_and_slows_in_a_spe
     assert track[track[:, 0] < 0.5, 2].max() > 0.45
     assert track[track[:, 0] > 1.2, 2].max() <= 0.2 + 1e-6
     assert (True, 40.0) in source.limits
+
+
+async def test_override_lethal_cost_lowers_the_keepout_zone_while_the_robot_stands_in_it() -> None:
+    from aiorobot.msgs.nav2_msgs import CostmapFilterInfo
+    from aiorobot.msgs.nav_msgs import OccupancyGrid
+    from aiorobot.nav._filter_inputs import FilterInputs
+    from aiorobot.nav._map_server import MAP_QOS
+
+    class Controller:
+        def set_speed_limit(self, limit: float, percentage: bool) -> None:
+            self.limit = (limit, percentage)
+
+    async with Runtime(handle_signals=False) as rt:
+        node = rt.add_node(Node("costmap", parameter_overrides={
+            "filters": ["keepout_filter"], "keepout_filter.plugin": "nav2_costmap_2d::KeepoutFilter",
+            "keepout_filter.filter_info_topic": "keepout_costmap_filter_info", "keepout_filter.override_lethal_cost": True,
+            "keepout_filter.lethal_override_cost": 200}))
+        filters = FilterInputs(node)
+        source = rt.add_node(Node("source"))
+        source.create_publisher(OccupancyGrid, "keepout_filter_mask", MAP_QOS).publish(_mask([KEEPOUT]).to_msg())
+        source.create_publisher(CostmapFilterInfo, "keepout_costmap_filter_info", MAP_QOS).publish(
+            CostmapFilterInfo(type=0, filter_mask_topic="keepout_filter_mask", base=0.0, multiplier=1.0))
+        cm = _room()
+        filters.attach(cm)
+        for _ in range(500):
+            await rt.settle()
+            if filters.keepout is not None:
+                break
+        controller = Controller()
+        assert cm.cost_at(0.0, 0.0) == LETHAL_OBSTACLE
+        filters.update(controller, 0.0, 0.5)  # standing in the zone: its cells cost 200, the way out is open
+        assert filters.pose_lethal and cm.cost_at(0.0, 0.0) == 200 and controller.limit == (NO_SPEED_LIMIT, False)
+        assert plan(cm, (0.0, 0.5), (-2.0, 0.5)).length_m < 2.5
+        filters.update(controller, -2.0, 0.5)  # out again: the zone is lethal
+        assert not filters.pose_lethal and cm.cost_at(0.0, 0.0) == LETHAL_OBSTACLE
