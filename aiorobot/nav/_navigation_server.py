@@ -172,9 +172,15 @@ class NavigationServer(Node):
         self._subscribe_localization()
         self.filters = FilterInputs(self)  # Nav2's costmap filters: keepout (planner) and speed (controller)
         self._busy = False
+        from ._footprint import warm_up as warm_up_footprint
         from ._kernels import warm_up
 
-        compile_kernels(self.get_logger(), lambda: warm_up("astar", "shortcut", "raytrace_clear"))  # not at the first goal
+        def warm() -> None:  # not at the first goal
+            warm_up("astar", "shortcut", "raytrace_clear")
+            if not footprint.is_circular:
+                warm_up_footprint()
+
+        compile_kernels(self.get_logger(), warm)
         self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)

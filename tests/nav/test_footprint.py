@@ -121,3 +121,13 @@ def test_simulator_footprint_parameter_reaches_the_collision_model() -> None:
     assert sim.body.footprint is not None and sim.body.footprint.tolist() == [[0.2, 0.15], [0.2, -0.15], [-0.2, -0.15], [-0.2, 0.15]]
     with pytest.raises(ValueError, match=r"^footprint: expected \[\] or 3 or more \[x, y\] points such as .*, found '\[\[1, 2\]\]'$"):
         Simulator(parameter_overrides={"footprint": "[[1, 2]]"})
+
+
+def test_navigation_server_takes_nav2s_footprint_parameters() -> None:
+    from aiorobot.nav import NavigationServer
+
+    server = NavigationServer(parameter_overrides={"footprint": "[[0.2, 0.15], [0.2, -0.15], [-0.2, -0.15], [-0.2, 0.15]]",
+                                                   "footprint_padding": 0.0})
+    assert server.costmap_params["footprint"].inscribed_radius == pytest.approx(0.15)
+    with pytest.raises(ValueError, match=r"^navigation_server: parameter footprint: expected at least 3 points, found 1$"):
+        NavigationServer(parameter_overrides={"footprint": "[[0.2, 0.15]]"})
