@@ -3,7 +3,8 @@
 - A* on a 400x400 inflated costmap (a seeded maze of walls), corner to corner;
 - an AMCL update with 500 particles x 60 beams (sensor model + resampling);
 - a costmap update from one 360-beam scan (obstacle layer + inflation) on a 400x400 map;
-- one Regulated Pure Pursuit step.
+- one Regulated Pure Pursuit step;
+- one collision monitor check of a command against a 360-beam scan (stop, slowdown and approach zones).
 """
 
 from __future__ import annotations
@@ -77,7 +78,30 @@ def run(quick: bool = False) -> dict[str, Any]:
     path = plan(cm, (0.5, 0.5), (19.5, 19.5)).poses
     rpp.set_plan(path)
     out["rpp_step_us"] = _timed(lambda: rpp.step((float(path[0, 0]), float(path[0, 1]), float(path[0, 2])), 0.3), n * 10)
+    out["collision_monitor_scan_us"] = _timed(_collision_monitor_step(), n * 10)
     return out
+
+
+def _collision_monitor_step() -> Any:
+    """A scan of 360 beams (a room 1.5-4 m away, seeded) to base-frame points, then Nav2's default zones decide a command."""
+    from aiorobot.nav import ActionType, CollisionMonitor, Zone
+
+    monitor = CollisionMonitor([
+        Zone("PolygonStop", ActionType.STOP, vertices=[[0.3, 0.3], [0.3, -0.3], [0.0, -0.3], [0.0, 0.3]], min_points=4),
+        Zone("PolygonSlow", ActionType.SLOWDOWN, vertices=[[0.4, 0.4], [0.4, -0.4], [-0.4, -0.4], [-0.4, 0.4]], slowdown_ratio=0.3),
+        Zone("FootprintApproach", ActionType.APPROACH, vertices=[[0.25, 0.2], [0.25, -0.2], [-0.25, -0.2], [-0.25, 0.2]],
+             min_points=6, time_before_collision=2.0, simulation_time_step=0.1),
+    ])
+    ranges = np.random.default_rng(2).uniform(1.5, 4.0, 360)
+    angles = np.linspace(-math.pi, math.pi, 360, endpoint=False)
+    laser = np.eye(4)
+    laser[0, 3] = 0.1
+
+    def step() -> None:
+        pts = np.column_stack([ranges * np.cos(angles), ranges * np.sin(angles), np.zeros(360)]) @ laser[:3, :3].T + laser[:3, 3]
+        monitor.decide((0.5, 0.0, 0.3), {"scan": np.ascontiguousarray(pts[:, :2])})
+
+    return step
 
 
 def table(part: dict[str, Any]) -> Any:
@@ -88,5 +112,7 @@ def table(part: dict[str, Any]) -> Any:
         ("costmap update from one 360-beam scan (target <= 2 ms)", part["costmap_scan_update_us"]),
         ("Regulated Pure Pursuit step", part["rpp_step_us"]),
     ]
+    if "collision_monitor_scan_us" in part:  # parts recorded before the monitor existed lack it
+        rows.append(("collision monitor, one 360-beam scan (target <= 2 ms)", part["collision_monitor_scan_us"]))
     return figure_table("navigation cores (ms)", ("figure", "p50", "p99", "max"),
                         [(name, s["p50_us"] / 1e3, s["p99_us"] / 1e3, s["max_us"] / 1e3) for name, s in rows])

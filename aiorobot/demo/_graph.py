@@ -2,7 +2,8 @@
 
 Main loop: the simulator, the serial motor bridge (``drive = "serial"``), AMCL or the landmark
 fixes, perception's front ends (ArUco in a worker process, lidar segmentation in the thread pool),
-the navigation server and the navigator. Priority loop: the mecanum base controller (serial
+the navigation server and the navigator. Priority loop: the collision monitor (between the
+navigation server's /cmd_vel_nav and the base's /cmd_vel), the mecanum base controller (serial
 drive) and the EKFs (robot_localization's dual set-up, ``dual_ekf.yaml``, which
 ``examples/fusion_ekf.toml`` shares). The nodes and their fixed parameters are in ``graph.toml``
 (:data:`GRAPH_FILE`); :func:`build_graph` picks those the options ask for and adds the run's own.
@@ -35,7 +36,7 @@ GRAPH_FILE = Path(__file__).with_name("graph.toml")
 #: node name in GRAPH_FILE -> the DemoGraph attribute that holds it
 _ROLES = {"simulator": "simulator", "mecanum_controller": "control_node", "ekf_local": "ekf_local",
           "landmark_fixes": "landmark_fixes", "aruco": "aruco", "scan_obstacles": "scan_obstacles",
-          "navigation_server": "server"}
+          "navigation_server": "server", "collision_monitor": "collision_monitor"}
 
 
 @dataclass
@@ -45,6 +46,7 @@ class DemoGraph:
     nodes: list[tuple[Any, str]] = field(default_factory=list)
     simulator: Any = None
     server: Any = None
+    collision_monitor: Any = None
     control_node: Any = None
     aruco: Any = None
     ekf_local: Any = None
@@ -68,14 +70,14 @@ def time_source_for(rtf: float) -> str:
 def _construct(spec: Any, run_parameters: dict[str, Any]) -> Any:
     """Construct the node of one ``[[nodes]]`` table of :data:`GRAPH_FILE` with the run's parameters added.
 
-    As ``aiorobot run`` builds a node (the table's name and namespace, its parameters over its
+    As ``aiorobot run`` builds a node (the table's name, namespace and remappings, its parameters over its
     parameters_file), without wrapping the node's own errors: the demo reports those as they are.
     """
     module_name, _, class_name = spec.use.partition(":")
     cls = getattr(importlib.import_module(module_name), class_name)
     parameters = {k: list(v) if isinstance(v, tuple) else v for k, v in spec.parameters.items()}
     parameters.update(run_parameters)
-    kwargs: dict[str, Any] = {"parameter_overrides": parameters, "remappings": {"__node": spec.name}}
+    kwargs: dict[str, Any] = {"parameter_overrides": parameters, "remappings": {"__node": spec.name, **spec.remap}}
     if spec.namespace:
         kwargs["namespace"] = spec.namespace
     if spec.parameters_file:
@@ -138,6 +140,7 @@ def build_graph(
         },
         "ekf_local": {},
         "navigation_server": {},
+        "collision_monitor": {},
     }
     if drive == "serial":
         g.port_link = os.path.join(tempfile.gettempdir(), f"aiorobot-demo-motors-{os.getpid()}")

@@ -1,7 +1,7 @@
-"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation (pure cores).
+"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation, the collision monitor (pure cores).
 
 Cores follow Nav2's definitions and parameter names (nav2_costmap_2d, NavFn/Smac 2D,
-nav2_regulated_pure_pursuit_controller, nav2_amcl) on numpy arrays, with Numba kernels where
+nav2_regulated_pure_pursuit_controller, nav2_amcl, nav2_collision_monitor) on numpy arrays, with Numba kernels where
 they loop; they are tested without a runtime.
 """
 
@@ -16,6 +16,10 @@ from ._costmap import (
     Costmap,
     inflation_cost,
 )
+from ._collision_monitor import ActionType, CollisionAction, CollisionMonitor, Zone
+from ._collision_monitor_node import CollisionMonitorNode, CollisionMonitorStatistics
+from ._filters import NO_SPEED_LIMIT, FilterType, SpeedLimitFilter, keepout_layer, mask_cost
+from ._footprint import Footprint
 from ._maps import MapError, OccupancyMap, load_map, save_map
 from ._planner import Plan, PlanError, PlanFailure, plan
 from ._amcl_node import AmclNode
@@ -37,6 +41,18 @@ from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
 
 __all__ = [
+    "ActionType",
+    "CollisionAction",
+    "CollisionMonitor",
+    "CollisionMonitorNode",
+    "CollisionMonitorStatistics",
+    "Footprint",
+    "FilterType",
+    "NO_SPEED_LIMIT",
+    "SpeedLimitFilter",
+    "keepout_layer",
+    "mask_cost",
+    "Zone",
     "AmclNode",
     "LandmarkFixNode",
     "LANDMARK_MAP_SUFFIX",

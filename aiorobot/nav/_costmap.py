@@ -13,15 +13,26 @@ lethal, the cells along each beam cleared), and inflation with Nav2's cost funct
     distance <= inflation_radius      -> (INSCRIBED - 1) * exp(-cost_scaling_factor * (distance - inscribed_radius))
 
 with ``distance`` the Euclidean distance between cell centres (InflationLayer::computeCost).
+
+The robot's shape is a :class:`~aiorobot.nav.Footprint` (Nav2's ``footprint`` polygon or
+``robot_radius``): its inscribed radius is inflation's ``inscribed_radius``, and
+:meth:`Costmap.in_collision` checks a pose with it. A keepout filter's mask (Nav2's
+KeepoutFilter costs) is merged into the static layer before inflation, unlike Nav2, which applies
+filters after it: a keepout zone then keeps the robot's body out, not only its centre, and the
+controller's collision check does not stop the robot on a path hugging the zone's edge.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from ._footprint import Footprint
 
 __all__ = [
     "FREE_SPACE",
@@ -53,7 +64,8 @@ class Costmap:
     """A 2D costmap: ``cost`` (H, W) uint8, ``resolution`` (m/cell), ``origin`` (x, y) of cell (0, 0)'s corner.
 
     Parameters as Nav2's: ``robot_radius`` (inscribed radius of a round footprint),
-    ``inflation_radius``, ``cost_scaling_factor``.
+    ``inflation_radius``, ``cost_scaling_factor``. A ``footprint`` (a :class:`Footprint`) sets
+    ``robot_radius`` to its inscribed radius; without one the robot is the disc of ``robot_radius``.
     """
 
     static: NDArray[np.uint8]
@@ -62,8 +74,15 @@ class Costmap:
     robot_radius: float = 0.22
     inflation_radius: float = 0.55
     cost_scaling_factor: float = 3.0
+    footprint: Footprint | None = None
 
     def __post_init__(self) -> None:
+        from ._footprint import Footprint
+
+        if self.footprint is None:
+            self.footprint = Footprint.circle(self.robot_radius)
+        else:
+            self.robot_radius = self.footprint.inscribed_radius
         self.static = np.ascontiguousarray(self.static, dtype=np.uint8)
         if self.static.ndim != 2 or min(self.static.shape) < 1:
             raise ValueError(f"costmap: expected a (H, W) grid, got shape {self.static.shape}")
@@ -73,6 +92,8 @@ class Costmap:
             raise ValueError(
                 f"costmap: inflation_radius ({self.inflation_radius}) must be >= robot_radius ({self.robot_radius}), as in Nav2"
             )
+        #: the keepout filter's costs on this grid (NO_INFORMATION: no say), merged into the static layer
+        self.keepout: NDArray[np.uint8] | None = None
         self.obstacles = np.zeros_like(self.static)
         self.cost = np.empty_like(self.static)
         self._static_cost: NDArray[np.uint8] | None = None
@@ -109,6 +130,32 @@ class Costmap:
         r, c = self.world_to_cell(x, y)
         return int(self.cost[r, c]) if self.in_bounds(r, c) else NO_INFORMATION
 
+    def footprint_cost(self, x: float, y: float, yaw: float) -> int:
+        """Nav2's ``footprintCostAtPose``: the highest cost along the footprint's outline at (x, y, yaw)."""
+        from ._footprint import footprint_cost
+
+        assert self.footprint is not None
+        return footprint_cost(self.cost, self.footprint.at(x, y, yaw), self.origin, self.resolution)
+
+    def in_collision(self, x: float, y: float, yaw: float, *, allow_unknown: bool = True) -> bool:
+        """Whether the robot at (x, y, yaw) touches an obstacle.
+
+        A round robot: its centre cell is INSCRIBED or LETHAL (an obstacle within the radius).
+        A polygon: that, or a LETHAL cell on its outline (Nav2's RPP check). Unknown space counts
+        as free with ``allow_unknown`` (Nav2's track_unknown_space), else as an obstacle.
+        """
+        centre = self.cost_at(x, y)
+        if centre == NO_INFORMATION:
+            if not allow_unknown:
+                return True
+        elif centre >= INSCRIBED_INFLATED_OBSTACLE:
+            return True
+        assert self.footprint is not None
+        if self.footprint.is_circular:
+            return False
+        outline = self.footprint_cost(x, y, yaw)
+        return outline == LETHAL_OBSTACLE or (outline == NO_INFORMATION and not allow_unknown)
+
     def clear_obstacles(self) -> None:
         self.obstacles[:] = 0
 
@@ -133,7 +180,7 @@ class Costmap:
         update only inflates the obstacle layer, inside the window its marks can reach.
         """
         if self._static_cost is None or self._static_cost.shape != self.static.shape:
-            self._static_cost = self._inflate(self.static)
+            self._static_cost = self._inflate(self._with_keepout(self.static))
         cost = self._static_cost.copy()
         marks = np.argwhere(self.obstacles == LETHAL_OBSTACLE)
         if len(marks):
@@ -147,6 +194,27 @@ class Costmap:
             merged[self.obstacles[r0:r1, c0:c1] == LETHAL_OBSTACLE] = LETHAL_OBSTACLE  # ...unless an obstacle was seen there
             cost[r0:r1, c0:c1] = merged
         self.cost = cost
+
+    def _with_keepout(self, layer: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """``layer`` under the keepout filter: Nav2's KeepoutFilter rule, a mask cost replaces a lower or unknown one."""
+        if self.keepout is None:
+            return layer
+        out = layer.copy()
+        k = self.keepout
+        take = (k != NO_INFORMATION) & ((k > out) | (out == NO_INFORMATION))
+        out[take] = k[take]
+        return out
+
+    def set_keepout(self, layer: NDArray[np.uint8] | None) -> None:
+        """Install (or with None remove) a keepout filter layer (H, W) of costs, see
+        :func:`~aiorobot.nav.keepout_layer`, and recompute the costs."""
+        if layer is not None:
+            layer = np.ascontiguousarray(layer, dtype=np.uint8)
+            if layer.shape != self.static.shape:
+                raise ValueError(f"set_keepout: expected a layer of the costmap's shape {self.static.shape}, found {layer.shape}")
+        self.keepout = layer
+        self._static_cost = None
+        self.update()
 
     def _inflate(self, layer: NDArray[np.uint8]) -> NDArray[np.uint8]:
         """``layer`` with its lethal cells inflated (cells outside ``inflation_radius`` keep their value)."""

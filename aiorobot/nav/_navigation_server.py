@@ -6,6 +6,14 @@ inflation), reads the robot pose from tf (``global_frame`` -> ``robot_base_frame
 replans every ``replan_period`` (Nav2's default behaviour tree replans at 1 Hz), follows the path
 with RPP at ``controller_frequency`` and publishes ``/cmd_vel`` and ``/plan``.
 
+The robot's shape is Nav2's costmap parameters ``footprint`` (a polygon ``"[[x, y], ...]"``, padded
+by ``footprint_padding``) or ``robot_radius``: the costmap inflates by its inscribed radius, and the
+planner and RPP's collision check test the footprint at each pose.
+
+Costmap filters as Nav2's (``filters``, each with its ``plugin`` and ``filter_info_topic``): a
+keepout mask makes its cells obstacles for the planner, a speed mask caps RPP's speed where the
+robot is (see :mod:`aiorobot.nav._filter_inputs`).
+
 When blocked (collision ahead, no progress within ``movement_time_allowance``, no path) it runs
 Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle layer and replan,
 wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason. A goal outside the
@@ -38,6 +46,7 @@ from .._core._node import Node
 from .._core._warm_up import compile_kernels
 from .._core._qos import QoSProfile, ReliabilityPolicy
 from ._costmap import Costmap
+from ._filter_inputs import FilterInputs
 from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
@@ -131,8 +140,16 @@ class NavigationServer(Node):
         self.max_localization_std = float(d("max_localization_std", 0.5).value)
         self.max_localization_yaw_std = float(d("max_localization_yaw_std", 0.8).value)
         self.localization_recovery_timeout = float(d("localization_recovery_timeout", 5.0).value)
+        from ._footprint import Footprint
+
+        robot_radius = float(d("robot_radius", 0.22).value)
+        try:  # Nav2's costmap parameters: a footprint polygon wins over robot_radius
+            footprint = Footprint.from_parameters(d("footprint", "[]").value, robot_radius, float(d("footprint_padding", 0.01).value))
+        except ValueError as err:
+            raise ValueError(f"{self.get_name()}: {err}") from None
         self.costmap_params = {
-            "robot_radius": float(d("robot_radius", 0.22).value),
+            "footprint": footprint,
+            "robot_radius": robot_radius,
             "inflation_radius": float(d("inflation_radius", 0.55).value),
             "cost_scaling_factor": float(d("cost_scaling_factor", 3.0).value),
         }
@@ -157,10 +174,17 @@ class NavigationServer(Node):
         #: why the last pose estimate counts as lost (None: fine, or no estimate seen)
         self.localization_lost: str | None = None
         self._subscribe_localization()
+        self.filters = FilterInputs(self)  # Nav2's costmap filters: keepout (planner) and speed (controller)
         self._busy = False
+        from ._footprint import warm_up as warm_up_footprint
         from ._kernels import warm_up
 
-        compile_kernels(self.get_logger(), lambda: warm_up("astar", "shortcut", "raytrace_clear"))  # not at the first goal
+        def warm() -> None:  # not at the first goal
+            warm_up("astar", "shortcut", "raytrace_clear")
+            if not footprint.is_circular:
+                warm_up_footprint()
+
+        compile_kernels(self.get_logger(), warm)
         self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)
@@ -182,6 +206,7 @@ class NavigationServer(Node):
         self.map = OccupancyMap.from_msg(msg)
         self.costmap = Costmap.from_occupancy(self.map.data, self.map.width, self.map.height, self.map.resolution,
                                               self.map.origin[:2], **self.costmap_params)
+        self.filters.attach(self.costmap)
 
     def _subscribe_localization(self) -> None:
         from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
@@ -445,6 +470,7 @@ class NavigationServer(Node):
                     continue
                 first_plan = False
                 last_plan_at = t
+            self.filters.update(rpp, pose[0], pose[1])
             cmd = rpp.step(pose, speed)
             if cmd.goal_reached:
                 self._stop_base()

@@ -3,7 +3,7 @@
 ``plan(costmap, start_xy, goal_xy)`` returns the path as world points (N, 2) through cell
 centres, shortened by line-of-sight where that never raises the peak cost along the way, then
 resampled at the costmap's resolution, with a yaw per point (the heading to the next point; the
-last takes the goal's yaw when given).
+last takes the goal's yaw when given). A polygon footprint on the costmap must fit at every pose.
 """
 
 from __future__ import annotations
@@ -56,9 +56,12 @@ def _blocked(value: int, allow_unknown: bool) -> bool:
 
 def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, float], *, goal_yaw: float | None = None,
          neutral_cost: float = 1.0, cost_factor: float = 3.0, allow_unknown: bool = True, smooth: bool = True) -> Plan:
-    """A* from ``start_xy`` to ``goal_xy`` (world, m). Raises PlanError saying why when there is no path."""
-    from ._kernels import astar
+    """A* from ``start_xy`` to ``goal_xy`` (world, m). Raises PlanError saying why when there is no path.
 
+    With a polygon footprint on the costmap every pose is checked in the path's heading
+    (:meth:`Costmap.in_collision`); cells where it does not fit are left out and the search runs
+    again (Nav2's 2D planners check the centre cell only, its IsPathValid the footprint).
+    """
     sr, sc = costmap.world_to_cell(*start_xy)
     gr, gc = costmap.world_to_cell(*goal_xy)
     for what, (r, c), xy in (("start", (sr, sc), start_xy), ("goal", (gr, gc), goal_xy)):
@@ -72,7 +75,38 @@ def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, 
     if _blocked(int(cost[sr, sc]), allow_unknown):  # a start inside inflation: plan out of it as Nav2 planners do
         cost = cost.copy()
         cost[sr, sc] = INSCRIBED_INFLATED_OBSTACLE - 1
-    cells, total = astar(cost, sr, sc, gr, gc, float(neutral_cost), float(cost_factor), bool(allow_unknown))
+    blocked = 0
+    for _ in range(_FOOTPRINT_ROUNDS):
+        poses, total = _search(costmap, cost, (sr, sc), (gr, gc), start_xy, goal_xy, goal_yaw, neutral_cost, cost_factor,
+                               allow_unknown, smooth)
+        hits = _footprint_hits(costmap, poses, allow_unknown)
+        if not len(hits):
+            seg = np.linalg.norm(np.diff(poses[:, :2], axis=0), axis=1) if len(poses) > 1 else np.zeros(0)
+            return Plan(poses, float(seg.sum()), float(total))
+        # the polygon footprint touches an obstacle there (in the path's heading): keep the search out of those cells
+        if cost is costmap.cost:
+            cost = cost.copy()
+        before = blocked
+        for x, y, yaw in poses[hits]:
+            blocked += _block_around(costmap, cost, x, y, yaw, ((sr, sc), (gr, gc)))
+        if blocked == before:  # only the goal's pose is left: the footprint does not fit there in the goal's yaw
+            break
+    raise PlanError(f"no path from ({start_xy[0]:.2f}, {start_xy[1]:.2f}) to ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}) that the robot's "
+                    f"footprint fits along ({blocked} cells where it touches an obstacle left out in {_FOOTPRINT_ROUNDS} searches)",
+                    PlanFailure.NO_VALID_PATH)
+
+
+#: searches :func:`plan` makes for a polygon footprint before it gives up
+_FOOTPRINT_ROUNDS = 8
+
+
+def _search(costmap: Costmap, cost: NDArray[np.uint8], start: tuple[int, int], goal: tuple[int, int], start_xy: tuple[float, float],
+            goal_xy: tuple[float, float], goal_yaw: float | None, neutral_cost: float, cost_factor: float, allow_unknown: bool,
+            smooth: bool) -> tuple[NDArray[np.float64], float]:
+    """A* on ``cost``, smoothed and resampled: poses (N, 3) and the search cost."""
+    from ._kernels import astar
+
+    cells, total = astar(cost, start[0], start[1], goal[0], goal[1], float(neutral_cost), float(cost_factor), bool(allow_unknown))
     if cells.shape[0] == 0:
         raise PlanError(f"no path from ({start_xy[0]:.2f}, {start_xy[1]:.2f}) to ({goal_xy[0]:.2f}, {goal_xy[1]:.2f}): the goal is unreachable",
                         PlanFailure.NO_VALID_PATH)
@@ -91,8 +125,32 @@ def plan(costmap: Costmap, start_xy: tuple[float, float], goal_xy: tuple[float, 
         yaw[-1] = yaw[-2] if goal_yaw is None else goal_yaw
     else:
         yaw[:] = 0.0 if goal_yaw is None else goal_yaw
-    seg = np.linalg.norm(np.diff(xy, axis=0), axis=1) if len(xy) > 1 else np.zeros(0)
-    return Plan(np.column_stack([xy, yaw]), float(seg.sum()), float(total))
+    return np.column_stack([xy, yaw]), float(total)
+
+
+def _block_around(costmap: Costmap, cost: NDArray[np.uint8], x: float, y: float, yaw: float, keep: tuple[tuple[int, int], ...]) -> int:
+    """Block the cells near (x, y) where the footprint in heading ``yaw`` touches an obstacle (the whole
+    width of a gap it does not fit, in one go); returns how many were newly blocked."""
+    assert costmap.footprint is not None
+    reach = int(math.ceil(costmap.footprint.circumscribed_radius / costmap.resolution))
+    r0, c0 = costmap.world_to_cell(x, y)
+    count = 0
+    for r in range(max(r0 - reach, 0), min(r0 + reach + 1, costmap.shape[0])):
+        for c in range(max(c0 - reach, 0), min(c0 + reach + 1, costmap.shape[1])):
+            if (r, c) in keep or cost[r, c] >= INSCRIBED_INFLATED_OBSTACLE:
+                continue
+            if costmap.in_collision(*costmap.cell_to_world(r, c), yaw):
+                cost[r, c] = INSCRIBED_INFLATED_OBSTACLE
+                count += 1
+    return count
+
+
+def _footprint_hits(costmap: Costmap, poses: NDArray[np.float64], allow_unknown: bool) -> NDArray[np.int64]:
+    """Indices of the poses (x, y, yaw) where a polygon footprint touches an obstacle (none for a round one:
+    inflation by its radius already keeps the search clear). The first pose (the robot, where it is) is not checked."""
+    if costmap.footprint is None or costmap.footprint.is_circular:
+        return np.zeros(0, dtype=np.int64)
+    return np.array([i for i in range(1, len(poses)) if costmap.in_collision(*poses[i], allow_unknown=allow_unknown)], dtype=np.int64)
 
 
 def shortcut(cost: NDArray[np.uint8], cells: NDArray[np.int64], max_skip: int = 400) -> NDArray[np.int64]:

@@ -14,8 +14,8 @@ Same parameters and regulation functions (``regulation_functions.hpp``):
 - rotate to heading: when the carrot is more than ``rotate_to_heading_min_angle`` off the heading
   (and at the goal, to the goal's yaw) the base turns in place at ``rotate_to_heading_angular_vel``;
 - collision detection: the commanded arc is projected forward for up to
-  ``max_allowed_time_to_collision_up_to_carrot``; a lethal/inscribed cell on it stops the base and
-  sets ``collision_ahead``.
+  ``max_allowed_time_to_collision_up_to_carrot``; the costmap's footprint touching an obstacle at a
+  pose on it (:meth:`Costmap.in_collision`) stops the base and sets ``collision_ahead``.
 """
 
 from __future__ import annotations
@@ -101,6 +101,18 @@ class RegulatedPurePursuit:
         self.path: NDArray[np.float64] = np.zeros((0, 3))
         self._last_angular = 0.0
         self._progress = 0
+        #: the speed the regulation starts from: ``desired_linear_vel`` unless a speed limit holds
+        self.desired_linear_vel = self.p.desired_linear_vel
+
+    def set_speed_limit(self, speed_limit: float, percentage: bool) -> None:
+        """Nav2's ``setSpeedLimit``: cap the speed at ``speed_limit`` (percent of ``desired_linear_vel``
+        or m/s); 0.0 (NO_SPEED_LIMIT) lifts the cap.
+
+        rclpy difference: an absolute limit above ``desired_linear_vel`` does not raise the speed.
+        """
+        from ._filters import limited_speed
+
+        self.desired_linear_vel = min(limited_speed(self.p.desired_linear_vel, speed_limit, percentage), self.p.desired_linear_vel)
 
     def set_plan(self, poses: NDArray[np.float64]) -> None:
         poses = np.asarray(poses, dtype=np.float64)
@@ -186,7 +198,7 @@ class RegulatedPurePursuit:
 
     def _regulate(self, curvature: float, xy: tuple[float, float], remaining: float) -> float:
         p = self.p
-        raw = p.desired_linear_vel
+        raw = self.desired_linear_vel
         curv_vel = raw
         if p.use_regulated_linear_velocity_scaling and abs(curvature) > 1e-9:
             radius = abs(1.0 / curvature)
@@ -204,7 +216,7 @@ class RegulatedPurePursuit:
         if remaining < p.approach_velocity_scaling_dist:
             scaled = raw * remaining / p.approach_velocity_scaling_dist
             linear = min(linear, max(scaled, p.min_approach_linear_velocity))
-        return min(linear, p.desired_linear_vel)
+        return min(linear, raw)
 
     def _rotate(self, angle: float, carrot: tuple[float, float], lookahead: float = 0.0) -> RppCommand:
         p = self.p
@@ -230,7 +242,6 @@ class RegulatedPurePursuit:
             x += linear * math.cos(th) * dt
             y += linear * math.sin(th) * dt
             th += angular * dt
-            c = self.costmap.cost_at(x, y)
-            if INSCRIBED_INFLATED_OBSTACLE <= c < NO_INFORMATION:
+            if self.costmap.in_collision(x, y, th):  # the costmap's footprint at each pose of the arc
                 return True
         return False

@@ -59,6 +59,9 @@ class RobotBody:
         Start ``(x, y, yaw)`` in the map frame.
     radius : float
         Footprint radius (m) for collisions.
+    footprint : array_like, shape (M, 2), optional
+        A polygon footprint in the base frame (a mecanum base is a rectangle); replaces the disc
+        of ``radius`` for collisions.
     max_acceleration : array_like, shape (3,)
         Per-axis acceleration limits (m/s^2, m/s^2, rad/s^2).
     wheel_slip, odom_scale_error, odom_noise_std : float
@@ -73,6 +76,7 @@ class RobotBody:
         pose: ArrayLike = (0.0, 0.0, 0.0),
         *,
         radius: float = 0.2,
+        footprint: ArrayLike | None = None,
         max_acceleration: ArrayLike = (2.0, 2.0, 4.0),
         wheel_slip: float = 0.0,
         odom_scale_error: float = 0.0,
@@ -83,6 +87,11 @@ class RobotBody:
         self.holonomic = isinstance(kinematics, Mecanum)
         self.pose = np.asarray(pose, dtype=np.float64).copy()
         self.radius = float(radius)
+        self.footprint = None if footprint is None else np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
+        if self.footprint is not None and (len(self.footprint) < 3 or not np.isfinite(self.footprint).all()):
+            raise ValueError(f"footprint: expected 3 or more finite [x, y] points, found {self.footprint.tolist()}")
+        #: the disc around the base that holds the footprint (a free disc is a free footprint)
+        self._outer = self.radius if self.footprint is None else float(np.hypot(*self.footprint.T).max())
         self.max_acceleration = np.asarray(max_acceleration, dtype=np.float64)
         if not 0.0 <= wheel_slip < 1.0:
             raise ValueError(f"wheel_slip: expected a fraction in [0, 1), found {wheel_slip!r}")
@@ -134,9 +143,9 @@ class RobotBody:
         self.velocity = self.velocity + np.clip(self.command - self.velocity, -limit, limit)
         twist = self.velocity * (1.0 - self.wheel_slip)
         candidate = integrate_twist(self.pose, twist, dt_sec)
-        if world.is_free_disc(candidate[0], candidate[1], self.radius):
+        if self._free(world, candidate):
             self._move_to(candidate)
-            if self.in_contact and world.is_free_disc(candidate[0], candidate[1], self.radius + _CONTACT_MARGIN_M):
+            if self.in_contact and self._free(world, candidate, _CONTACT_MARGIN_M):
                 self.in_contact = False
         else:
             # move as far as the wall allows (bisection on the step), then stop
@@ -144,7 +153,7 @@ class RobotBody:
             for _ in range(12):
                 mid = 0.5 * (lo + hi)
                 trial = integrate_twist(self.pose, twist, dt_sec * mid)
-                if world.is_free_disc(trial[0], trial[1], self.radius):
+                if self._free(world, trial):
                     lo = mid
                 else:
                     hi = mid
@@ -169,6 +178,17 @@ class RobotBody:
             believed[1] = 0.0
         self.odom_twist = believed
         self.odom_pose = integrate_twist(self.odom_pose, believed, dt_sec)
+
+    def _free(self, world: World, pose: NDArray[np.float64], margin: float = 0.0) -> bool:
+        """Whether the footprint (grown by ``margin`` m) at ``pose`` touches nothing."""
+        x, y = float(pose[0]), float(pose[1])
+        if self.footprint is None:
+            return world.is_free_disc(x, y, self.radius + margin)
+        if world.is_free_disc(x, y, self._outer + margin):
+            return True
+        v = self.footprint + np.sign(self.footprint) * margin
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        return world.is_free_polygon(np.column_stack([x + c * v[:, 0] - s * v[:, 1], y + s * v[:, 0] + c * v[:, 1]]))
 
     def _move_to(self, pose: NDArray[np.float64]) -> None:
         self.distance_m += math.hypot(pose[0] - self.pose[0], pose[1] - self.pose[1])

@@ -96,6 +96,21 @@ class SimulatorStatistics:
         return self.sim_time_ns / _NS
 
 
+def _footprint(text: str) -> np.ndarray | None:
+    """The ``footprint`` parameter (``"[[x, y], ...]"``) as (M, 2) vertices; None for ``"[]"``."""
+    import json
+
+    try:
+        rows = json.loads(text) if text.strip() else []
+        vertices = np.asarray(rows, dtype=np.float64).reshape(-1, 2) if rows else None
+    except (ValueError, TypeError):
+        vertices = np.zeros((0, 2))
+    if vertices is not None and (len(vertices) < 3 or not np.isfinite(vertices).all()):
+        raise ValueError(f"footprint: expected [] or 3 or more [x, y] points such as \"[[0.2, 0.15], [0.2, -0.15], "
+                         f"[-0.2, -0.15], [-0.2, 0.15]]\", found {text!r}")
+    return vertices
+
+
 class _Stream:
     """One periodic output: the k-th sample is due at ``round(k / rate)`` seconds (no rounding drift)."""
 
@@ -131,6 +146,10 @@ class Simulator(Node):
         ``[x, y, yaw]`` (m, m, rad) in map: where the robot starts; refused when its disc is
         blocked. Unset: the world's start (else the origin), or, when that is blocked or in
         unknown space (a Nav2 map), the known-free cell nearest to it, with a warning.
+    robot_radius, footprint : float, str
+        The robot's shape for collisions: the disc of ``robot_radius``, or with ``footprint``
+        (Nav2's costmap form, ``"[[x, y], ...]"`` in base_link) that polygon; a mecanum base is a
+        rectangle. The start is checked with the disc.
     robot : str
         ``mecanum`` or ``diff``; geometry from ``wheel_radius``, ``wheel_separation`` (diff),
         ``half_length`` and ``half_width`` (mecanum), as in ``aiorobot.control``.
@@ -176,6 +195,8 @@ class Simulator(Node):
             half_width=p("half_width", 0.15, description="m (mecanum)", range=(0.0, 10.0), read_only=True).value,
         )
         radius = p("robot_radius", 0.22, description="collision footprint radius, m", range=(0.01, 10.0), read_only=True).value
+        footprint = _footprint(p("footprint", "[]", description="collision polygon [[x, y], ...] in base_link, m "
+                                 "(Nav2's costmap form; [] for the disc of robot_radius)", read_only=True).value)
         rates = {
             name: p(f"{name}_rate", default, description=f"{name} rate, Hz (0: off)", range=(0.0, 10000.0), read_only=True).value
             for name, default in (("scan", 10.0), ("imu", 100.0), ("odom", 50.0), ("camera", 15.0), ("ground_truth", 50.0))
@@ -225,7 +246,7 @@ class Simulator(Node):
         self.kinematics = make_kinematics(str(robot), **geometry)
         self.robot_kind = str(robot)
         self.body = RobotBody(
-            self.kinematics, self.start, radius=radius,
+            self.kinematics, self.start, radius=radius, footprint=footprint,
             max_acceleration=(accel[0], accel[0], accel[1]), wheel_slip=noise["wheel_slip"],
             odom_scale_error=noise["odom_scale_error"], odom_noise_std=noise["odom_noise_std"], rng=self._rng_odom,
         )

@@ -165,6 +165,66 @@ class World:
         dy = np.clip(y, cy0, cy0 + res) - y
         return bool(np.all(dx * dx + dy * dy > radius * radius))
 
+    def is_free_polygon(self, outline: NDArray[np.float64]) -> bool:
+        """True when no occupied cell (nor the map edge) touches the polygon ``outline`` (M, 2), in map coordinates.
+
+        A cell touches it when one of the polygon's edges crosses the cell's square or a corner of
+        the square lies inside the polygon (a cell wholly inside it).
+        """
+        poly = np.asarray(outline, dtype=np.float64).reshape(-1, 2)
+        ox, oy, _ = self.origin
+        res = self.resolution
+        h, w = self.occupied.shape
+        c0, c1 = math.floor((poly[:, 0].min() - ox) / res), math.floor((poly[:, 0].max() - ox) / res)
+        r0, r1 = math.floor((poly[:, 1].min() - oy) / res), math.floor((poly[:, 1].max() - oy) / res)
+        if c0 < 0 or r0 < 0 or c1 >= w or r1 >= h:
+            return False
+        rows, cols = np.nonzero(self.occupied[r0 : r1 + 1, c0 : c1 + 1])
+        if not len(rows):
+            return True
+        lo_x = (ox + (cols + c0) * res)[:, None]  # (K, 1) cell squares against (1, M) edges
+        lo_y = (oy + (rows + r0) * res)[:, None]
+        a, b = poly, np.roll(poly, -1, axis=0)
+        dx, dy = (b[:, 0] - a[:, 0])[None, :], (b[:, 1] - a[:, 1])[None, :]
+        # Liang-Barsky: the part of each edge a + t (b - a), t in [0, 1], inside each square
+        t0, t1 = np.zeros((len(rows), len(poly))), np.ones((len(rows), len(poly)))
+        for d, lo, start in ((dx, lo_x, a[None, :, 0]), (dy, lo_y, a[None, :, 1])):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ta, tb = (lo - start) / d, (lo + res - start) / d
+            flat = d == 0.0
+            outside = flat & ((start < lo) | (start > lo + res))
+            t0 = np.where(flat, np.where(outside, np.inf, t0), np.maximum(t0, np.minimum(ta, tb)))
+            t1 = np.where(flat, t1, np.minimum(t1, np.maximum(ta, tb)))
+        if np.any(t0 <= t1):
+            return False
+        # no edge crosses an occupied square: one could still lie wholly inside the polygon
+        corner_x, corner_y = lo_x[:, 0], lo_y[:, 0]
+        inside = np.zeros(len(rows), dtype=bool)
+        for i in range(len(poly)):
+            (xi, yi), (xj, yj) = poly[i - 1], poly[i]
+            crosses = (corner_y <= yi) != (corner_y <= yj)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                x_at = xi + (corner_y - yi) * (xj - xi) / (yj - yi)
+            inside ^= crosses & (x_at > corner_x)
+        return not inside.any()
+
+    def add_obstacle(self, x: float, y: float, half_x: float, half_y: float | None = None) -> None:
+        """Put a box of half sizes ``half_x`` by ``half_y`` (m) centred at ``(x, y)`` into the world, not the map.
+
+        What a person or a pushed box is: from now on it blocks the lidar's rays and the robot,
+        while the map (``occupancy``, what the simulator publishes on ``/map``) stays as it was.
+        """
+        half_y = half_x if half_y is None else half_y
+        ox, oy, _ = self.origin
+        res = self.resolution
+        h, w = self.occupied.shape
+        c0, c1 = max(math.floor((x - half_x - ox) / res), 0), min(math.ceil((x + half_x - ox) / res), w)
+        r0, r1 = max(math.floor((y - half_y - oy) / res), 0), min(math.ceil((y + half_y - oy) / res), h)
+        if c0 >= c1 or r0 >= r1:
+            raise ValueError(f"add_obstacle: the box at ({x:g}, {y:g}) of half sizes {half_x:g} x {half_y:g} m is outside {self!r}")
+        self.occupied[r0:r1, c0:c1] = 1
+        object.__setattr__(self, "_clearance", None)  # recomputed from the new grid at the next ray cast
+
     def to_image(self) -> NDArray[np.uint8]:
         """The grid as a map_server image (top row = highest y): free 254, occupied 0, unknown 205."""
         image = np.full(self.occupancy.shape, 205, dtype=np.uint8)

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from aiorobot import load_config
-from aiorobot.demo._graph import GRAPH_FILE, build_graph
+from aiorobot.demo._graph import GRAPH_FILE, ROBOT_RADIUS, build_graph
 from aiorobot.sim import World
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fusion_ekf.toml"
@@ -22,12 +23,12 @@ def _layout(graph) -> list[tuple[str, str]]:
     ("localisation", "perception", "expected"),
     [
         ("amcl", True, [("/simulator", "main"), ("/local/ekf_local", "priority"), ("/amcl", "main"),
-                        ("/aruco", "main"), ("/scan_obstacles", "main"), ("/navigation_server", "main")]),
+                        ("/aruco", "main"), ("/scan_obstacles", "main"), ("/navigation_server", "main"), ("/collision_monitor", "priority")]),
         ("amcl", False, [("/simulator", "main"), ("/local/ekf_local", "priority"), ("/amcl", "main"),
-                         ("/navigation_server", "main")]),
+                         ("/navigation_server", "main"), ("/collision_monitor", "priority")]),
         ("landmarks", True, [("/simulator", "main"), ("/local/ekf_local", "priority"), ("/landmark_fixes", "main"),
                              ("/global/ekf_global", "priority"), ("/aruco", "main"), ("/scan_obstacles", "main"),
-                             ("/navigation_server", "main")]),
+                             ("/navigation_server", "main"), ("/collision_monitor", "priority")]),
     ],
 )
 def test_the_options_pick_the_graph_files_nodes_and_add_the_runs_parameters(localisation, perception, expected) -> None:
@@ -36,8 +37,12 @@ def test_the_options_pick_the_graph_files_nodes_and_add_the_runs_parameters(loca
                         start=(0.5, -0.5, 0.25))
     assert _layout(graph) == expected
     assert graph.control_node is graph.ekf_local and graph.server.get_name() == "navigation_server"
+    # the controller's commands go through the collision monitor to the base
+    assert graph.server.cmd_pub.topic_name == "/cmd_vel_nav" and graph.collision_monitor.cmd_pub.topic_name == "/cmd_vel"
     sim = graph.simulator
     assert sim.get_parameter("world").value == str(world.path) and sim.get_parameter("seed").value == 3
+    # a rectangular base inside the disc the navigation server and the start checks use
+    assert sim.body.footprint is not None and np.hypot(*sim.body.footprint.T).max() <= ROBOT_RADIUS
     assert sim.get_parameter("camera_rate").value == (15.0 if perception else 0.0)
     if localisation == "landmarks":
         ekf_global = graph.nodes[3][0]
@@ -52,7 +57,7 @@ def test_the_graph_file_is_an_aiorobot_run_config_naming_every_node() -> None:
     config = load_config(GRAPH_FILE)
     assert [n.name for n in config.nodes] == [
         "simulator", "serial_motor_bridge", "mecanum_controller", "ekf_local", "amcl", "landmark_fixes", "ekf_global",
-        "aruco", "scan_obstacles", "navigation_server"]
+        "aruco", "scan_obstacles", "navigation_server", "collision_monitor"]
 
 
 def test_the_example_and_the_demo_run_one_definition_of_the_dual_ekf() -> None:
