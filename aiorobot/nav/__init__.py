@@ -1,7 +1,7 @@
-"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation (pure cores).
+"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation, online SLAM (pure cores).
 
 Cores follow Nav2's definitions and parameter names (nav2_costmap_2d, NavFn/Smac 2D,
-nav2_regulated_pure_pursuit_controller, nav2_amcl) on numpy arrays, with Numba kernels where
+nav2_regulated_pure_pursuit_controller, nav2_amcl, slam_toolbox) on numpy arrays, with Numba kernels where
 they loop; they are tested without a runtime.
 """
 
@@ -35,6 +35,8 @@ from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
+from ._slam import Slam, SlamParameters, SlamStatistics
+from ._slam_node import SlamNode
 
 __all__ = [
     "AmclNode",
@@ -73,6 +75,10 @@ __all__ = [
     "RegulatedPurePursuit",
     "RppCommand",
     "RppParameters",
+    "Slam",
+    "SlamNode",
+    "SlamParameters",
+    "SlamStatistics",
     "inflation_cost",
     "likelihood_field",
     "load_map",
