@@ -4,80 +4,31 @@ a false closure, a saved graph that reloads and keeps mapping, and bad input."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
 
+from aiorobot.demo._slam_figures import (
+    WAREHOUSE_LOOP,
+    WAREHOUSE_START,
+    ScriptedRun,
+    map_agreement,
+    route_poses,
+    scripted_mapping_run,
+    wheel_odometry,
+)
 from aiorobot.nav._slam import Slam, SlamParameters
 from aiorobot.nav._slam_graph import PoseGraph, relative
 from aiorobot.sim import World
 from aiorobot.sim._sensors import LidarModel
 
-#: the warehouse loop (~48 m): east through the south-west room's door, up the aisle between the
-#: shelf rows, west along the north side, through the north-west room and its inner door, home
-WAREHOUSE_START = (-8.0, -5.0, 0.0)
-WAREHOUSE_LOOP = [(-1.5, -5.0), (4.75, -5.0), (4.75, 5.25), (-1.5, 5.25), (-1.5, 4.2), (-6.5, 4.2), (-6.6, -2.0),
-                  (-8.0, -5.0), (-5.0, -5.0)]
-
-
-def trajectory(start: tuple[float, float, float], waypoints: list[tuple[float, float]], step: float = 0.05,
-               turn: float = 0.1) -> np.ndarray:
-    """True poses (N, 3) every ``step`` m / ``turn`` rad: turn on the spot to face each waypoint, drive to it."""
-    x, y, th = start
-    poses = [start]
-    for wx, wy in waypoints:
-        d = (math.atan2(wy - y, wx - x) - th + math.pi) % (2 * math.pi) - math.pi
-        n = int(math.ceil(abs(d) / turn))
-        for _ in range(n):
-            th += d / n
-            poses.append((x, y, th))
-        n = int(math.ceil(math.hypot(wx - x, wy - y) / step))
-        for k in range(n):
-            x += (wx - x) / (n - k)
-            y += (wy - y) / (n - k)
-            poses.append((x, y, th))
-    return np.array(poses)
-
-
-def odometry(truth: np.ndarray, scale_error: float, noise: float, seed: int) -> np.ndarray:
-    """Wheel odometry (odom frame, from zero) of ``truth``: every step scaled by 1 + scale_error, times
-    1 + N(0, noise) per axis, as the simulator's RobotBody integrates it."""
-    rng = np.random.default_rng(seed)
-    out = [(0.0, 0.0, 0.0)]
-    for a, b in zip(truth[:-1], truth[1:]):
-        step = np.array(relative(tuple(a), tuple(b))) * (1 + scale_error) * (1 + rng.normal(0, noise, 3))
-        ox, oy, oth = out[-1]
-        c, s = math.cos(oth), math.sin(oth)
-        out.append((ox + c * step[0] - s * step[1], oy + s * step[0] + c * step[1], oth + step[2]))
-    return np.array(out)
-
-
-@dataclass
-class Run:
-    slam: Slam
-    world: World
-    truth: np.ndarray
-    odom: np.ndarray
-    estimates: np.ndarray  #: map -> base_link after each scan
-    node_scans: list[int]  #: the scan index each graph node was made from
+Run = ScriptedRun
 
 
 def drive(world: World, start: tuple[float, float, float], waypoints: list[tuple[float, float]],
-          params: SlamParameters | None = None, *, seed: int = 0, scale_error: float = 0.03, step: float = 0.1) -> Run:
-    """Scans every ``step`` m (10 Hz at 1 m/s) along the waypoints, fed to a fresh :class:`Slam`."""
-    truth = trajectory(start, waypoints, step=step)
-    odom = odometry(truth, scale_error, 0.01, seed)
-    lidar, rng = LidarModel(), np.random.default_rng(seed + 1)
-    slam = Slam(params, start_pose=start)
-    estimates, nodes = [], []
-    for k, (p, o) in enumerate(zip(truth, odom)):
-        update = slam.add_scan(tuple(o), lidar.measure(world, p[0], p[1], p[2], rng), lidar.angle_min,
-                               lidar.angle_increment, lidar.range_min, lidar.range_max)
-        estimates.append(slam.pose)
-        if update.node >= 0:
-            nodes.append(k)
-    return Run(slam, world, truth, odom, np.array(estimates), nodes)
+          params: SlamParameters | None = None, *, seed: int = 0, scale_error: float = 0.03) -> Run:
+    """Scans every 0.1 m (10 Hz at 1 m/s) along the waypoints, 3 % odometry scale error, a fresh Slam."""
+    return scripted_mapping_run(world, start, waypoints, params, seed=seed, scale_error=scale_error)
 
 
 @pytest.fixture(scope="module")
@@ -108,8 +59,6 @@ def test_warehouse_loop_with_3_percent_odometry_error_meets_the_accuracy_targets
 
 
 def test_the_built_map_agrees_with_the_world(warehouse_run: Run) -> None:
-    from aiorobot.demo._slam_figures import map_agreement
-
     run = warehouse_run
     agreement = map_agreement(run.slam.occupancy_map(), run.world, run.truth[run.node_scans, :2])
     assert agreement.precision >= 0.95  # occupied cells within 0.1 m of a true wall
@@ -192,8 +141,8 @@ def test_a_saved_graph_localises_a_robot_without_changing(warehouse_run: Run, tm
     assert len(slam.graph) == len(warehouse_run.slam.graph) and slam.params.mode == "localization"
     np.testing.assert_array_equal(slam.graph.poses, warehouse_run.slam.graph.poses)
     start = (0.0, -5.0, 0.0)
-    truth = trajectory(start, [(4.75, -5.0), (4.75, 0.0)], step=0.1)
-    odom = odometry(truth, 0.03, 0.01, seed=9)
+    truth = route_poses(start, [(4.75, -5.0), (4.75, 0.0)])
+    odom = wheel_odometry(truth, 0.03, 0.01, seed=9)
     slam.continue_from((start[0] + 0.08, start[1] - 0.05, 0.03))  # told roughly where it stands
     lidar, rng = LidarModel(), np.random.default_rng(5)
     errors = []

@@ -14,7 +14,7 @@ from aiorobot import Node
 from aiorobot.sim import World
 from aiorobot.sim._sensors import LidarModel
 
-from .test_slam import odometry, trajectory
+from aiorobot.demo._slam_figures import route_poses, wheel_odometry
 
 #: a loop round the box world's pillar (about 12 m), 5 cm a step
 BOX_START = (-1.5, -1.5, 0.0)
@@ -91,8 +91,8 @@ async def mapped(sim_runtime):  # type: ignore[no-untyped-def]
 
     sim = SimClock(sim_runtime)
     await sim.start()
-    truth = trajectory(BOX_START, BOX_LOOP)
-    robot = sim_runtime.add_node(ScriptedRobot(truth, odometry(truth, 0.03, 0.01, seed=3)))
+    truth = route_poses(BOX_START, BOX_LOOP)
+    robot = sim_runtime.add_node(ScriptedRobot(truth, wheel_odometry(truth, 0.03, 0.01, seed=3)))
     slam = sim_runtime.add_node(SlamNode(parameter_overrides={"map_start_pose": list(BOX_START), "map_update_interval": 1.0,
                                                               "max_laser_range": 8.0}))
     await _drive(sim, robot)
@@ -191,8 +191,8 @@ async def test_save_map_serialise_and_reload_continue_mapping(mapped, sim_runtim
     nodes = len(slam.slam.graph)
     assert len(other.slam.graph) == nodes
     # odometry restarts from zero on the second run; the robot drives on from where it stood
-    more = trajectory(tuple(here), [(0.0, 0.0), (1.0, 0.5)])
-    robot.truth, robot.odom, robot.k = more, odometry(more, 0.03, 0.01, seed=4), 0
+    more = route_poses(tuple(here), [(0.0, 0.0), (1.0, 0.5)])
+    robot.truth, robot.odom, robot.k = more, wheel_odometry(more, 0.03, 0.01, seed=4), 0
     await _drive(sim, robot)
     s = other.slam.statistics()
     assert len(other.slam.graph) > nodes
