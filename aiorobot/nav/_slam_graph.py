@@ -134,6 +134,14 @@ class PoseGraph:
             m = len(ii)
             rows_b = np.repeat(np.arange(3), 3)
             cols_b = np.tile(np.arange(3), 3)
+            # the sparsity pattern is the same every step: block (i, i), (i, j), (j, i), (j, j) of each edge,
+            # then the prior on node 0 (fixed: a stiff prior keeps H regular and the anchor where it is)
+            pairs = [(ii, ii), (ii, jj), (jj, ii), (jj, jj)]
+            rows = np.concatenate([((3 * r)[:, None] + rows_b[None]).ravel() for r, _ in pairs] + [np.arange(3)])
+            cols = np.concatenate([((3 * c)[:, None] + cols_b[None]).ravel() for _, c in pairs] + [np.arange(3)])
+            anchor = np.full(3, 1e12)
+            gi = (3 * ii[:, None] + np.arange(3)[None]).ravel()
+            gj = (3 * jj[:, None] + np.arange(3)[None]).ravel()
             for it in range(1, iterations + 1):
                 p = self.poses
                 xi, xj = p[ii], p[jj]
@@ -155,19 +163,11 @@ class PoseGraph:
                 info = self.edge_info * w[:, None, None]
                 ai = np.einsum("mba,mbc->mac", a, info)  # A^T Omega
                 bi = np.einsum("mba,mbc->mac", b, info)
-                blocks = [(ii, ii, ai @ a), (ii, jj, ai @ b), (jj, ii, bi @ a), (jj, jj, bi @ b)]
-                rows = np.concatenate([(3 * r)[:, None] + rows_b[None] for r, _, _ in blocks]).ravel()
-                cols = np.concatenate([(3 * c)[:, None] + cols_b[None] for _, c, _ in blocks]).ravel()
-                data = np.concatenate([blk.reshape(m, 9) for _, _, blk in blocks]).ravel()
-                # node 0 fixed: a stiff prior on it keeps H regular and the anchor where it is
-                rows = np.concatenate([rows, np.arange(3)])
-                cols = np.concatenate([cols, np.arange(3)])
-                data = np.concatenate([data, np.full(3, 1e12)])
+                data = np.concatenate([(ai @ a).ravel(), (ai @ b).ravel(), (bi @ a).ravel(), (bi @ b).ravel(), anchor])
                 h = coo_matrix((data, (rows, cols)), shape=(3 * n, 3 * n)).tocsc()
-                g = np.zeros(3 * n)
-                np.add.at(g, (3 * ii[:, None] + np.arange(3)[None]).ravel(), np.einsum("mab,mb->ma", ai, e).ravel())
-                np.add.at(g, (3 * jj[:, None] + np.arange(3)[None]).ravel(), np.einsum("mab,mb->ma", bi, e).ravel())
-                dx_all = spsolve(h, -g)
+                g = (np.bincount(gi, (ai @ e[:, :, None]).ravel(), minlength=3 * n)
+                     + np.bincount(gj, (bi @ e[:, :, None]).ravel(), minlength=3 * n))
+                dx_all = spsolve(h, -g, permc_spec="MMD_AT_PLUS_A")  # H is symmetric
                 if not np.all(np.isfinite(dx_all)):
                     break
                 self.poses = p + dx_all.reshape(n, 3)
