@@ -125,7 +125,7 @@ def _slam(quick: bool) -> dict[str, Any]:
         graph.optimize()
 
     out["slam_optimise_500_us"] = _timed(optimise, max(3, n // 5))
-    route = WAREHOUSE_LOOP[:2] if quick else WAREHOUSE_LOOP
+    route = WAREHOUSE_LOOP[:1] if quick else WAREHOUSE_LOOP
     run = scripted_mapping_run(world, WAREHOUSE_START, route, step=0.05)  # 10 Hz scans at 0.5 m/s
     sim_sec = len(run.truth) / 10.0
     out["slam_mapping_run"] = {"sim_sec": sim_sec, "wall_sec": run.total_sec, "slam_sec": run.slam_sec,
