@@ -45,7 +45,11 @@ class SlamNode(Node):
     ``minimum_travel_heading``, ``do_loop_closing``, ``loop_search_maximum_distance``, ...) and
     ``odom_frame`` (odom), ``map_frame`` (map), ``base_frame`` (base_link), ``scan_topic`` (/scan),
     ``map_update_interval`` (5.0 s), ``transform_publish_period`` (0.05 s), ``transform_timeout``
-    (0.2 s), ``map_file_name`` (a .posegraph to start from) and ``map_start_pose`` ([x, y, yaw])."""
+    (0.2 s), ``map_file_name`` (a .posegraph to start from) and ``map_start_pose`` ([x, y, yaw]).
+
+    rclpy difference: slam_toolbox's interface with other defaults, another graph file format and
+    ``map_start_pose`` placing a fresh map too; see docs/rclpy-differences.md.
+    """
 
     def __init__(self, node_name: str = "slam_toolbox", **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
