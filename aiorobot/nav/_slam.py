@@ -147,8 +147,7 @@ class Slam:
         self._last_stamp: float | None = None
         self._prev_node: int | None = None  #: the last node this session added (None: none yet, or after load)
         self._odometry_link = True  #: whether odometry since _prev_node is continuous
-        self._frozen = 0  #: nodes loaded for localization: matched against, never moved
-        self._local: list[int] = []  #: localization mode's recent transient nodes (indices into _loc_*)
+        #: localization mode's recent scans (not graph nodes): matched against with the loaded nodes
         self._loc_poses: list[tuple[float, float, float]] = []
         self._loc_points: list[NDArray[np.float64]] = []
         self._mapper: Any = None  #: the log-odds grid and how many nodes it holds
@@ -357,22 +356,13 @@ class Slam:
         near = np.flatnonzero(np.hypot(self.graph.poses[:, 0] - prior[0], self.graph.poses[:, 1] - prior[1])
                               <= p.loop_search_maximum_distance)
         refs = [transform_points(self.graph.poses[j], self.node_points[j]) for j in near]
-        refs += [transform_points(q, pts) for q, pts in zip(self._loc_poses[-3:], self._loc_points[-3:])]
+        refs += [transform_points(q, pts) for q, pts in zip(self._loc_poses, self._loc_points)]
         pose = self._match_near(np.vstack(refs), points, prior, odom)[0] if refs else prior
-        self._loc_poses = (self._loc_poses + [pose])[-p.scan_buffer_size:]
-        self._loc_points = (self._loc_points + [points])[-p.scan_buffer_size:]
+        self._loc_poses = (self._loc_poses + [pose])[-3:]  # the last three: where the loaded map ends, they carry on
+        self._loc_points = (self._loc_points + [points])[-3:]
         self._anchor = (pose, odom)
         self.map_to_odom = compose(pose, relative(odom, (0.0, 0.0, 0.0)))
         return SlamUpdate()
-
-    def set_pose(self, pose: tuple[float, float, float]) -> None:
-        """Declare map -> robot (localization's initial pose, or continuing a loaded map elsewhere)."""
-        pose = (float(pose[0]), float(pose[1]), float(pose[2]))
-        odom = self._last_odom or (0.0, 0.0, 0.0)
-        self.map_to_odom = compose(pose, relative(odom, (0.0, 0.0, 0.0)))
-        self._anchor = (pose, odom) if self._anchor is not None or len(self.graph) else None
-        if self._anchor is None and not len(self.graph):
-            self.start_pose = pose
 
     # -- map -----------------------------------------------------------------------------
 
@@ -467,7 +457,6 @@ class Slam:
         slam.node_points = np.split(np.asarray(data["points"], dtype=np.float64), np.cumsum(counts)[:-1])
         slam.node_odom = [tuple(map(float, q)) for q in data["node_odom"]]  # type: ignore[misc]
         slam.closures = [tuple(c) for c in meta.get("closures", [])]  # type: ignore[misc]
-        slam._frozen = len(slam.graph)
         if len(slam.graph):
             slam.start_pose = tuple(float(v) for v in slam.graph.poses[0])
         return slam

@@ -180,3 +180,12 @@ def test_core_ignores_and_counts_bad_input() -> None:
     assert math.hypot(*slam.pose[:2]) < 1e-9  # the robot did not move with the odometry
     grid = slam.occupancy_map()
     assert (grid.data == 100).sum() > 100
+
+
+def test_bad_parameters_are_refused_in_one_line() -> None:
+    with pytest.raises(ValueError, match=r"^mode: expected one of 'mapping', 'localization', found 'slam'$"):
+        SlamParameters(mode="slam")
+    with pytest.raises(ValueError, match=r"^resolution: expected a number > 0, found 0.0$"):
+        SlamParameters(resolution=0.0)
+    with pytest.raises(ValueError, match=r"^minimum_travel_distance: expected a finite number >= 0, found nan$"):
+        SlamParameters(minimum_travel_distance=float("nan"))
