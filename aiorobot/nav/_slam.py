@@ -8,7 +8,8 @@
    buffer (the last ``scan_buffer_size`` nodes within ``scan_buffer_maximum_scan_distance``),
    searched around the odometry prediction; it is linked to the previous node by a scan-match
    edge (covariance from the match) and an odometry edge (covariance growing with the motion).
-   A match whose response is below ``link_match_minimum_response_fine`` is not used: the node
+   A match whose response is below ``recovery_search_response`` is searched again over the loop
+   window (odometry slipped); one below ``link_match_minimum_response_fine`` is not used: the node
    keeps the odometry prediction.
 3. Loop closure (``do_loop_closing``): nodes older than the running buffer within
    ``loop_search_maximum_distance`` are candidates; with at least ``loop_match_minimum_chain_size``
@@ -67,6 +68,8 @@ class SlamParameters:
     scan_buffer_size: int = 20
     scan_buffer_maximum_scan_distance: float = 10.0
     link_match_minimum_response_fine: float = 0.1
+    #: ours: a match responding below this is searched again over the loop-closure window
+    recovery_search_response: float = 0.5
     correlation_search_space_dimension: float = 0.5
     correlation_search_space_resolution: float = 0.025
     correlation_search_space_smear_deviation: float = 0.03
@@ -112,6 +115,7 @@ class SlamStatistics:
     loop_closures_rejected: int
     loop_closure_attempts: int
     matches_failed: int
+    recovery_searches: int
     beams_invalid: int
     beams_out_of_range: int
     scans_empty: int
@@ -156,7 +160,7 @@ class Slam:
         self._map_version = 0
         self.closures: list[tuple[int, int]] = []
         self._counts = dict(scans=0, loop_closures=0, loop_closures_rejected=0, loop_closure_attempts=0,
-                            matches_failed=0, beams_invalid=0, beams_out_of_range=0, scans_empty=0, odometry_jumps=0, optimizations=0)
+                            matches_failed=0, recovery_searches=0, beams_invalid=0, beams_out_of_range=0, scans_empty=0, odometry_jumps=0, optimizations=0)
         self._last_match_ms = 0.0
         self._last_opt_ms = 0.0
 
@@ -250,11 +254,25 @@ class Slam:
         m = match(reference, points, prior, resolution=p.correlation_search_space_resolution,
                   smear_deviation=p.correlation_search_space_smear_deviation,
                   linear_half=0.5 * p.correlation_search_space_dimension, angular_half=p.coarse_search_angle_offset)
+        prior_cov = self._prior_covariance(odom)
+        if m.response < p.recovery_search_response:
+            # odometry put the scan where it does not fit (a slip, a glitch under load): search as widely
+            # as a loop closure does, and trust what fits there over the odometry
+            wide = match(reference, points, prior, resolution=p.loop_search_space_resolution,
+                         smear_deviation=p.loop_search_space_smear_deviation,
+                         linear_half=0.5 * p.loop_search_space_dimension, angular_half=p.coarse_search_angle_offset,
+                         block=8)
+            if wide.response > m.response:
+                m = match(reference, points, wide.pose, resolution=p.correlation_search_space_resolution,
+                          smear_deviation=p.correlation_search_space_smear_deviation,
+                          linear_half=0.5 * p.correlation_search_space_dimension, angular_half=p.coarse_search_angle_offset)
+                prior_cov = np.diag([1e2, 1e2, 1e2])
+                self._counts["recovery_searches"] += 1
         self._last_match_ms = (time.perf_counter() - t0) * 1e3
         if m.response < p.link_match_minimum_response_fine:
             self._counts["matches_failed"] += 1
             return prior, None
-        return _fuse(prior, self._prior_covariance(odom), m), m
+        return _fuse(prior, prior_cov, m), m
 
     def _buffer(self, pose: tuple[float, float, float], exclude_from: int) -> list[int]:
         """The running buffer: the nodes before ``exclude_from`` back along the chain; after a load,

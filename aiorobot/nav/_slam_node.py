@@ -189,7 +189,7 @@ class SlamNode(Node):
         s = self.slam.statistics()
         refused = {"beams_invalid": s.beams_invalid, "scans_empty": s.scans_empty,
                    "scans_without_transform": self.scans_without_transform, "odometry_jumps": s.odometry_jumps}
-        counts = {"scans": s.scans, "nodes": s.nodes, "loop_closures": s.loop_closures,
+        counts = {"scans": s.scans, "nodes": s.nodes, "loop_closures": s.loop_closures, "recovery_searches": s.recovery_searches,
                   "loop_closures_rejected": s.loop_closures_rejected, "matches_failed": s.matches_failed,
                   "beams_out_of_range": s.beams_out_of_range, **refused}
         bad = {k: v for k, v in refused.items() if v}

@@ -189,3 +189,27 @@ def test_bad_parameters_are_refused_in_one_line() -> None:
         SlamParameters(resolution=0.0)
     with pytest.raises(ValueError, match=r"^minimum_travel_distance: expected a finite number >= 0, found nan$"):
         SlamParameters(minimum_travel_distance=float("nan"))
+
+
+@pytest.mark.parametrize("recovery", [True, False])
+def test_an_odometry_glitch_under_the_jump_threshold_is_found_again_by_a_wide_search(recovery: bool) -> None:
+    """Odometry leaps 0.8 m and 0.1 rad (under maximum_odometry_jump, so taken as motion): the scan then fits
+    nowhere near the prediction, and the matcher searches the loop-closure window. Without that search
+    SLAM follows the odometry off the map and never comes back."""
+    from aiorobot.nav._slam_graph import compose
+
+    world = World.load("warehouse")
+    truth = route_poses(WAREHOUSE_START, [(-1.5, -5.0), (-1.5, -2.0)])
+    odom = wheel_odometry(truth, 0.03, 0.01, seed=0)
+    odom[30:] = [compose((-0.8, 0.2, 0.1), tuple(o)) for o in odom[30:]]
+    slam = Slam(SlamParameters(recovery_search_response=0.5 if recovery else 0.0), start_pose=WAREHOUSE_START)
+    lidar, rng = LidarModel(), np.random.default_rng(1)
+    errors = []
+    for p, o in zip(truth, odom):
+        slam.add_scan(tuple(o), lidar.measure(world, p[0], p[1], p[2], rng), lidar.angle_min, lidar.angle_increment,
+                      lidar.range_min, lidar.range_max)
+        errors.append(math.hypot(slam.pose[0] - p[0], slam.pose[1] - p[1]))
+    if recovery:
+        assert max(errors[40:]) < 0.05 and slam.statistics().recovery_searches >= 1
+    else:
+        assert min(errors[40:]) > 0.5
