@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ._maps import OccupancyMap
-from ._slam_graph import PoseGraph, compose, relative
+from ._slam_graph import PoseGraph, compose, relative, wrap
 from ._slam_matcher import Match, match, scan_points, transform_points
 
 __all__ = ["MODES", "Slam", "SlamParameters", "SlamStatistics", "SlamUpdate"]
@@ -505,9 +505,9 @@ def _fuse(prior: tuple[float, float, float], prior_cov: NDArray[np.float64], m: 
     b = np.linalg.inv(m.covariance + np.diag([1e-8, 1e-8, 1e-9]))
     mp = np.asarray(m.pose)
     d = np.asarray(prior) - mp
-    d[2] = (d[2] + math.pi) % (2 * math.pi) - math.pi
+    d[2] = wrap(d[2])
     x = mp + np.linalg.solve(a + b, a @ d)
-    return float(x[0]), float(x[1]), float((x[2] + math.pi) % (2 * math.pi) - math.pi)
+    return float(x[0]), float(x[1]), float(wrap(x[2]))
 
 
 def _edge_covariance(frame: tuple[float, float, float], cov_map: NDArray[np.float64]) -> NDArray[np.float64]:

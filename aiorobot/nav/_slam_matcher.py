@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _slam_kernels as k
+from ._slam_graph import wrap
 
 __all__ = ["Match", "match", "scan_points"]
 
@@ -102,11 +103,7 @@ def match(reference: NDArray[np.float64], points: NDArray[np.float64], prior: tu
     if ambiguity_radius > 0:
         runner_up = k.search(grid, coarse, block, points, float(prior[0]), float(prior[1]), thetas, half_cells,
                              ox, oy, resolution, x, y, ambiguity_radius)[3]
-    return Match((float(x), float(y), float(wrap_angle(th))), float(response), _covariance(jtj), float(best), float(runner_up))
-
-
-def wrap_angle(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
+    return Match((float(x), float(y), float(wrap(th))), float(response), _covariance(jtj), float(best), float(runner_up))
 
 
 def _covariance(jtj: NDArray[np.float64]) -> NDArray[np.float64]:
