@@ -5,6 +5,9 @@
 - a costmap update from one 360-beam scan (obstacle layer + inflation) on a 400x400 map;
 - one Regulated Pure Pursuit step;
 - one collision monitor check of a command against a 360-beam scan (stop, slowdown and approach zones).
+- SLAM (issue 30's targets): a scan match of 360 beams at 0.05 m against ten scans of the warehouse
+  (and at the default 0.025 m), the loop-closure optimisation of a 500-node graph, and a whole
+  mapping run of the warehouse loop (simulated lidar included) as a real-time factor.
 """
 
 from __future__ import annotations
@@ -79,6 +82,57 @@ def run(quick: bool = False) -> dict[str, Any]:
     rpp.set_plan(path)
     out["rpp_step_us"] = _timed(lambda: rpp.step((float(path[0, 0]), float(path[0, 1]), float(path[0, 2])), 0.3), n * 10)
     out["collision_monitor_scan_us"] = _timed(_collision_monitor_step(), n * 10)
+    out.update(_slam(quick))
+    return out
+
+
+def _slam(quick: bool) -> dict[str, Any]:
+    from aiorobot.demo._slam_figures import WAREHOUSE_LOOP, WAREHOUSE_START, scripted_mapping_run
+    from aiorobot.nav._slam_graph import PoseGraph, compose, relative
+    from aiorobot.nav._slam_matcher import match, scan_points, transform_points
+    from aiorobot.sim import World
+    from aiorobot.sim._sensors import LidarModel
+
+    n = 5 if quick else 50
+    out: dict[str, Any] = {}
+    world, lidar, rng = World.load("warehouse"), LidarModel(), np.random.default_rng(2)
+
+    def points(p: tuple[float, float, float]) -> np.ndarray:
+        return scan_points(lidar.measure(world, *p, rng).astype(np.float64), lidar.angle_min, lidar.angle_increment,
+                           lidar.range_min, lidar.range_max)
+
+    reference = np.vstack([transform_points(q, points(q)) for q in [(-1.0 + 0.5 * i, -5.0, 0.0) for i in range(10)]])
+    scan = points((4.2, -5.0, 0.02))
+    for key, res, sd in (("slam_match_005_us", 0.05, 0.05), ("slam_match_default_us", 0.025, 0.03)):
+        out[key] = _timed(lambda: match(reference, scan, (4.25, -4.97, 0.0), resolution=res, smear_deviation=sd,
+                                        linear_half=0.25, angular_half=0.349), n)
+    # a 500-node loop (0.5 m apart on a 40 m circle), 2 % drift in its chain, closed by ten closures
+    truth = [(40.0 * math.cos(a), 40.0 * math.sin(a), a + math.pi / 2) for a in np.linspace(0, 2 * math.pi, 500, endpoint=False)]
+    graph = PoseGraph()
+    pose = truth[0]
+    graph.add_node(pose)
+    noise = np.random.default_rng(3)
+    for k in range(1, 500):
+        z = relative(truth[k - 1], truth[k])
+        z = (z[0] * 1.02 + noise.normal(0, 0.005), z[1] + noise.normal(0, 0.005), z[2] * 1.01 + noise.normal(0, 0.002))
+        pose = compose(pose, z)
+        graph.add_node(pose)
+        graph.add_edge(k - 1, k, z, np.diag([1e-4, 1e-4, 3e-5]), "scan_match")
+    for j in range(10):
+        graph.add_edge(j, 490 + j, relative(truth[j], truth[490 + j]), np.diag([4e-4, 4e-4, 1e-4]), "loop_closure")
+    start = graph.poses.copy()
+
+    def optimise() -> None:
+        graph.poses = start.copy()
+        graph.optimize()
+
+    out["slam_optimise_500_us"] = _timed(optimise, max(3, n // 5))
+    route = WAREHOUSE_LOOP[:1] if quick else WAREHOUSE_LOOP
+    run = scripted_mapping_run(world, WAREHOUSE_START, route, step=0.05)  # 10 Hz scans at 0.5 m/s
+    sim_sec = len(run.truth) / 10.0
+    out["slam_mapping_run"] = {"sim_sec": sim_sec, "wall_sec": run.total_sec, "slam_sec": run.slam_sec,
+                               "real_time_factor": sim_sec / max(run.total_sec, 1e-9), "nodes": len(run.slam.graph),
+                               "loop_closures": run.slam.statistics().loop_closures}
     return out
 
 
@@ -111,8 +165,15 @@ def table(part: dict[str, Any]) -> Any:
         ("AMCL update, 500 particles x 60 beams (target <= 5 ms)", part["amcl_500x60_us"]),
         ("costmap update from one 360-beam scan (target <= 2 ms)", part["costmap_scan_update_us"]),
         ("Regulated Pure Pursuit step", part["rpp_step_us"]),
+        ("SLAM scan match, 360 beams at 0.05 m (target <= 5 ms)", part["slam_match_005_us"]),
+        ("SLAM scan match, 360 beams at the default 0.025 m", part["slam_match_default_us"]),
+        ("SLAM loop-closure optimisation, 500 nodes (target <= 50 ms)", part["slam_optimise_500_us"]),
     ]
     if "collision_monitor_scan_us" in part:  # parts recorded before the monitor existed lack it
         rows.append(("collision monitor, one 360-beam scan (target <= 2 ms)", part["collision_monitor_scan_us"]))
+    run = part["slam_mapping_run"]
     return figure_table("navigation cores (ms)", ("figure", "p50", "p99", "max"),
-                        [(name, s["p50_us"] / 1e3, s["p99_us"] / 1e3, s["max_us"] / 1e3) for name, s in rows])
+                        [(name, s["p50_us"] / 1e3, s["p99_us"] / 1e3, s["max_us"] / 1e3) for name, s in rows],
+                        caption=f"SLAM mapping run (simulated lidar + SLAM, {run['sim_sec']:.0f} s of 10 Hz scans, "
+                        f"{run['nodes']} nodes, {run['loop_closures']} loop closures): {run['real_time_factor']:.1f}x "
+                        f"real time (target >= 5x)")

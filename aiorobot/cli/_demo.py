@@ -62,6 +62,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--localisation", choices=("amcl", "landmarks"), default="amcl",
                         help="amcl: the particle filter on the lidar (default); landmarks: ArUco fixes from the "
                         "perception worker into the map-frame EKF")
+    parser.add_argument("--slam", action="store_true",
+                        help="no map given: SLAM (aiorobot.nav.SlamNode) builds it as the robot drives the waypoints and "
+                        "localises on it; the planner plans on the growing map (unknown space allowed). The summary "
+                        "adds the map's agreement with the world and the loop closures; --plot draws the built map "
+                        "over the true one")
     parser.add_argument("--no-perception", dest="perception", action="store_false",
                         help="leave out the camera, ArUco and lidar-obstacle perception (needs --localisation amcl)")
     parser.add_argument("--realtime", action="store_true",
@@ -97,6 +102,8 @@ def main(args: argparse.Namespace) -> int:
             if not world.is_free_disc(x, y, ROBOT_RADIUS):
                 raise ValueError(f"waypoint {i + 1} ({x:g}, {y:g}) is outside the map or inside an obstacle of {args.world}")
         start = resolve_start(world, args.start, ROBOT_RADIUS)
+        if args.slam and not args.waypoints:
+            waypoints.append(start.pose)  # home: SLAM closes the loop where it began
         drive = args.drive or ("serial" if args.rtf > 0 else "direct")
         if drive == "serial" and args.rtf == 0:
             raise ValueError("--drive serial needs --rtf > 0 (the simulated firmware's pty runs on the wall clock); "
@@ -104,6 +111,8 @@ def main(args: argparse.Namespace) -> int:
         if args.time_source == "system" and args.rtf != 1:
             raise ValueError(f"--time-source system needs --rtf 1 (stamps are system time), found --rtf {args.rtf:g}; "
                              "use --time-source sim")
+        if args.slam and args.localisation != "amcl":
+            raise ValueError(f"--slam localises on the map it builds: leave out --localisation {args.localisation}")
         if args.localisation == "landmarks" and not args.perception:
             raise ValueError("--localisation landmarks needs perception (drop --no-perception)")
         if args.record is not None and args.record.exists():
@@ -121,15 +130,16 @@ def main(args: argparse.Namespace) -> int:
         sys.stderr.flush()
 
     time_source = args.time_source or ("system" if args.rtf == 1 else "sim")
+    localisation = "slam" if args.slam else args.localisation
     if start.warning is not None:
         print(f"aiorobot demo: warning: {start.warning}", file=sys.stderr)
     print(f"aiorobot demo: {args.world}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
-          f"{args.localisation} localisation, seed {args.seed}, "
+          f"{localisation} localisation, seed {args.seed}, "
           f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time"
           f"{f', {args.duration:g} sim s' if args.duration else ''} (Ctrl-C stops)", file=sys.stderr)
     try:
         summary = aiorobot.run(run_demo(args.world, waypoints, rtf=args.rtf, seed=args.seed, drive=drive,
-                                        localisation=args.localisation, perception=args.perception,
+                                        localisation=localisation, perception=args.perception,
                                         record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress,
                                         time_source=args.time_source, realtime=args.realtime,
@@ -183,6 +193,12 @@ def _print_summary(s: object) -> None:
     ]
     if f["localisation"] == "landmarks":
         rows.insert(3, ("landmark fixes (with heading)", f"{f['landmark_fixes']} ({f.get('landmark_heading_fixes', 0)})"))
+    if f["localisation"] == "slam":
+        rows[2] = ("SLAM trajectory RMSE / max vs ground truth", rows[2][1])
+        rows.insert(3, ("SLAM graph nodes / loop closures", f"{f['slam_nodes']} / {f['slam_loop_closures']}"))
+        if f["slam_map_precision"] is not None:
+            rows.insert(4, ("map vs world: occupied within 0.1 m of a wall / walls seen marked",
+                            f"{f['slam_map_precision'] * 100:.1f} % / {f['slam_map_recall'] * 100:.1f} %"))
     if f["failures"]:
         rows.append(("node failures", "; ".join(f["failures"])))
     if f["record"]:

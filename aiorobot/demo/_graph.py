@@ -1,9 +1,10 @@
 """The demo's graph: which nodes, on which loop, with which parameters.
 
-Main loop: the simulator, the serial motor bridge (``drive = "serial"``), AMCL or the landmark
-fixes, perception's front ends (ArUco in a worker process, lidar segmentation in the thread pool),
-the navigation server and the navigator. Priority loop: the collision monitor (between the
-navigation server's /cmd_vel_nav and the base's /cmd_vel), the mecanum base controller (serial
+Main loop: the simulator, the serial motor bridge (``drive = "serial"``), AMCL, the landmark
+fixes or SLAM (no map given: the simulator's world map goes to ``/world/map``), perception's front
+ends (ArUco in a worker process, lidar segmentation in the thread pool), the navigation server and
+the navigator. Priority loop: the collision monitor (between the navigation server's /cmd_vel_nav
+and the base's /cmd_vel), the mecanum base controller (serial
 drive) and the EKFs (robot_localization's dual set-up, ``dual_ekf.yaml``, which
 ``examples/fusion_ekf.toml`` shares). The nodes and their fixed parameters are in ``graph.toml``
 (:data:`GRAPH_FILE`); :func:`build_graph` picks those the options ask for and adds the run's own.
@@ -22,13 +23,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["DRIVES", "LOCALISATIONS", "ROBOT_RADIUS", "DemoGraph", "build_graph", "time_source_for"]
+__all__ = ["DRIVES", "LOCALISATIONS", "ROBOT_RADIUS", "WORLD_MAP_TOPIC", "DemoGraph", "build_graph", "time_source_for"]
 
 #: ``direct``: the simulator follows /cmd_vel (lock-step possible); ``serial``: the simulated
 #: ESP32 firmware on a pty, through SerialMotorBridge and MecanumController (real time only).
 DRIVES = ("direct", "serial")
-#: ``amcl``: the particle filter on the lidar; ``landmarks``: ArUco fixes into the map-frame EKF.
-LOCALISATIONS = ("amcl", "landmarks")
+#: ``amcl``: the particle filter on the lidar; ``landmarks``: ArUco fixes into the map-frame EKF;
+#: ``slam``: no map given, SlamNode builds it (and localises on it) as the robot drives.
+LOCALISATIONS = ("amcl", "landmarks", "slam")
+#: where the simulator's world map goes under ``slam``: /map is SLAM's
+WORLD_MAP_TOPIC = "/world/map"
 #: The simulated robot's footprint radius (m): the simulator's default, what a start or a waypoint must leave free.
 ROBOT_RADIUS = 0.22
 #: The demo's graph: every node it may run, with the parameters no option changes (build_graph picks and adds).
@@ -36,7 +40,7 @@ GRAPH_FILE = Path(__file__).with_name("graph.toml")
 #: node name in GRAPH_FILE -> the DemoGraph attribute that holds it
 _ROLES = {"simulator": "simulator", "mecanum_controller": "control_node", "ekf_local": "ekf_local",
           "landmark_fixes": "landmark_fixes", "aruco": "aruco", "scan_obstacles": "scan_obstacles",
-          "navigation_server": "server", "collision_monitor": "collision_monitor"}
+          "navigation_server": "server", "collision_monitor": "collision_monitor", "slam_toolbox": "slam"}
 
 
 @dataclass
@@ -52,6 +56,7 @@ class DemoGraph:
     ekf_local: Any = None
     scan_obstacles: Any = None
     landmark_fixes: Any = None
+    slam: Any = None
     recorder: Any = None
     port_link: str | None = None
     #: the simulator's ``time_source``: ``system`` -> run the runtime with ``use_sim_time = False``
@@ -67,7 +72,7 @@ def time_source_for(rtf: float) -> str:
     return "system" if rtf == 1.0 else "sim"
 
 
-def _construct(spec: Any, run_parameters: dict[str, Any]) -> Any:
+def _construct(spec: Any, run_parameters: dict[str, Any], remappings: dict[str, str] | None = None) -> Any:
     """Construct the node of one ``[[nodes]]`` table of :data:`GRAPH_FILE` with the run's parameters added.
 
     As ``aiorobot run`` builds a node (the table's name, namespace and remappings, its parameters over its
@@ -77,7 +82,10 @@ def _construct(spec: Any, run_parameters: dict[str, Any]) -> Any:
     cls = getattr(importlib.import_module(module_name), class_name)
     parameters = {k: list(v) if isinstance(v, tuple) else v for k, v in spec.parameters.items()}
     parameters.update(run_parameters)
-    kwargs: dict[str, Any] = {"parameter_overrides": parameters, "remappings": {"__node": spec.name, **spec.remap}}
+    kwargs: dict[str, Any] = {
+        "parameter_overrides": parameters,
+        "remappings": {"__node": spec.name, **spec.remap, **(remappings or {})},
+    }
     if spec.namespace:
         kwargs["namespace"] = spec.namespace
     if spec.parameters_file:
@@ -147,8 +155,12 @@ def build_graph(
         run["simulator"]["port_link"] = g.port_link
         run["serial_motor_bridge"] = {"port": g.port_link}
         run["mecanum_controller"] = {}
+    remaps: dict[str, dict[str, str]] = {}
     if localisation == "amcl":
         run["amcl"] = {"initial_pose.x": sx, "initial_pose.y": sy, "initial_pose.yaw": syaw, "seed": seed}
+    elif localisation == "slam":
+        run["slam_toolbox"] = {"map_start_pose": [sx, sy, syaw]}  # the map frame is the world's
+        remaps["simulator"] = {"/map": WORLD_MAP_TOPIC}
     else:
         from aiorobot.nav import landmark_map_path
 
@@ -164,7 +176,7 @@ def build_graph(
         g.recorder = g.add(Recorder(path=record, all_topics=True, exclude=r"^/camera/image_raw$"))
     for spec in load_config(GRAPH_FILE).nodes:
         if spec.name in run:
-            node = g.add(_construct(spec, run[spec.name]), spec.executor)
+            node = g.add(_construct(spec, run[spec.name], remaps.get(spec.name)), spec.executor)
             if spec.name in _ROLES:
                 setattr(g, _ROLES[spec.name], node)
     if g.control_node is None:  # direct drive: the odometry EKF's timer is the priority loop's control timer

@@ -106,6 +106,11 @@ class DemoSummary:
     landmark_fixes: int = 0
     #: of those, the fixes from two or more markers in one image, which measured the heading too
     landmark_heading_fixes: int = 0
+    #: ``slam``: graph nodes and loop closures, and the built map against the world (see map_agreement)
+    slam_nodes: int | None = None
+    slam_loop_closures: int | None = None
+    slam_map_precision: float | None = None
+    slam_map_recall: float | None = None
     #: CPU of the main process (its loops and threads) and of the perception workers, % of one core
     cpu_pct: float = 0.0
     workers_cpu_pct: float = 0.0
@@ -122,6 +127,8 @@ class DemoSummary:
     truth: list[tuple[float, float]] = field(default_factory=list, repr=False)
     estimate: list[tuple[float, float]] = field(default_factory=list, repr=False)
     plans: list[list[tuple[float, float]]] = field(default_factory=list, repr=False)
+    #: ``slam``: the map SLAM built (an OccupancyMap), for ``--plot``
+    slam_map: Any = field(default=None, repr=False)
 
     @property
     def succeeded(self) -> bool:
@@ -136,7 +143,7 @@ class DemoSummary:
 
     def figures(self) -> dict[str, Any]:
         d = asdict(self)
-        for k in ("truth", "estimate", "plans"):
+        for k in ("truth", "estimate", "plans", "slam_map"):
             d.pop(k)
         return d
 
@@ -338,11 +345,13 @@ async def run_demo(
         drive = "serial" if rtf > 0 else "direct"
     try:  # everything that can refuse the input, before anything starts
         loaded = World.load(world)
+        choice = resolve_start(loaded, start, ROBOT_RADIUS)
         if waypoints is None:
             waypoints = mission_for(world)
             if waypoints is None:
                 raise ValueError(no_mission_message(world))
-        choice = resolve_start(loaded, start, ROBOT_RADIUS)
+            if localisation == "slam":
+                waypoints.append(choice.pose)  # home: SLAM closes the loop where it began
         graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
                             record=record, time_source=time_source, start=choice.pose)
     except ValueError as err:  # WorldError and the nodes' parameter errors among them
@@ -429,6 +438,8 @@ async def run_demo(
             if graph.landmark_fixes is not None:
                 summary.landmark_fixes = graph.landmark_fixes.fixes
                 summary.landmark_heading_fixes = graph.landmark_fixes.heading_fixes
+            if graph.slam is not None:
+                _slam_figures(summary, graph.slam, loaded)
             periods = probe.periods_ms(probe_from)
             if rtf > 0 and periods.size:
                 # sim-time periods: the wall period scaled by the real-time factor
@@ -454,6 +465,19 @@ async def run_demo(
     if graph.recorder is not None:
         summary.record = graph.recorder.path
     return summary
+
+
+def _slam_figures(summary: DemoSummary, node: Any, world: Any) -> None:
+    """The SLAM run's figures: nodes, loop closures, and the built map against the world along the route."""
+    from ._slam_figures import map_agreement
+
+    stats = node.slam.statistics()
+    summary.slam_nodes, summary.slam_loop_closures = stats.nodes, stats.loop_closures
+    if stats.nodes:
+        summary.slam_map = node.slam.occupancy_map(node.map_frame)
+        route = np.asarray(summary.truth[::5], dtype=np.float64).reshape(-1, 2)  # 1 Hz of the 5 Hz samples
+        agreement = map_agreement(summary.slam_map, world, route)
+        summary.slam_map_precision, summary.slam_map_recall = agreement.precision, agreement.recall
 
 
 def no_mission_message(world: str) -> str:

@@ -1,7 +1,8 @@
-"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation, the collision monitor (pure cores).
+"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation, the collision monitor,
+online SLAM (pure cores).
 
 Cores follow Nav2's definitions and parameter names (nav2_costmap_2d, NavFn/Smac 2D,
-nav2_regulated_pure_pursuit_controller, nav2_amcl, nav2_collision_monitor) on numpy arrays, with Numba kernels where
+nav2_regulated_pure_pursuit_controller, nav2_amcl, nav2_collision_monitor, slam_toolbox) on numpy arrays, with Numba kernels where
 they loop; they are tested without a runtime.
 """
 
@@ -39,6 +40,8 @@ from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
 from ._rpp import RegulatedPurePursuit, RppCommand, RppParameters
+from ._slam import Slam, SlamParameters, SlamStatistics
+from ._slam_node import SlamNode
 
 __all__ = [
     "ActionType",
@@ -89,6 +92,10 @@ __all__ = [
     "RegulatedPurePursuit",
     "RppCommand",
     "RppParameters",
+    "Slam",
+    "SlamNode",
+    "SlamParameters",
+    "SlamStatistics",
     "inflation_cost",
     "likelihood_field",
     "load_map",

@@ -57,7 +57,7 @@ def test_the_graph_file_is_an_aiorobot_run_config_naming_every_node() -> None:
     config = load_config(GRAPH_FILE)
     assert [n.name for n in config.nodes] == [
         "simulator", "serial_motor_bridge", "mecanum_controller", "ekf_local", "amcl", "landmark_fixes", "ekf_global",
-        "aruco", "scan_obstacles", "navigation_server", "collision_monitor"]
+        "slam_toolbox", "aruco", "scan_obstacles", "navigation_server", "collision_monitor"]
 
 
 def test_the_example_and_the_demo_run_one_definition_of_the_dual_ekf() -> None:
