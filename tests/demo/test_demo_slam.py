@@ -18,7 +18,7 @@ def test_the_slam_graph_moves_the_world_map_aside_and_starts_the_map_at_the_robo
     graph = build_graph(World.load("box"), rtf=0.0, seed=3, drive="direct", localisation="slam", perception=False,
                         start=(0.5, -0.5, 0.25))
     names = [node.get_fully_qualified_name() for node, _ in graph.nodes]
-    assert names == ["/simulator", "/local/ekf_local", "/slam_toolbox", "/navigation_server"]
+    assert names == ["/simulator", "/local/ekf_local", "/slam_toolbox", "/navigation_server", "/collision_monitor"]
     assert graph.simulator.map_pub.topic_name == WORLD_MAP_TOPIC  # /map is SLAM's alone
     assert list(graph.slam.get_parameter("map_start_pose").value) == [0.5, -0.5, 0.25]
 
