@@ -1,7 +1,7 @@
-"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation (pure cores).
+"""Navigation: costmaps, planning, Regulated Pure Pursuit, MPPI, AMCL localisation (pure cores).
 
 Cores follow Nav2's definitions and parameter names (nav2_costmap_2d, NavFn/Smac 2D,
-nav2_regulated_pure_pursuit_controller, nav2_amcl) on numpy arrays, with Numba kernels where
+nav2_regulated_pure_pursuit_controller, nav2_mppi_controller, nav2_amcl) on numpy arrays, with Numba kernels where
 they loop; they are tested without a runtime.
 """
 
@@ -31,6 +31,8 @@ from ._landmark_map import (
 )
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
 from ._map_server import MapServer
+from ._mppi import Mppi, MppiCommand
+from ._mppi_parameters import CRITICS as MPPI_CRITICS, MOTION_MODELS as MPPI_MOTION_MODELS, MppiParameters
 from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
@@ -50,6 +52,11 @@ __all__ = [
     "base_pose_from_markers",
     "map_from_marker",
     "MapServer",
+    "Mppi",
+    "MppiCommand",
+    "MppiParameters",
+    "MPPI_CRITICS",
+    "MPPI_MOTION_MODELS",
     "MappingNode",
     "OccupancyMapper",
     "NavigationFailure",
