@@ -1,10 +1,11 @@
 """``NavigationServer``: Nav2's navigate_to_pose, navigate_through_poses, follow_waypoints and
-compute_path_to_pose actions over the pure cores (costmap, planner, Regulated Pure Pursuit).
+compute_path_to_pose actions over the pure cores (costmap, planner, Regulated Pure Pursuit or MPPI).
 
 It keeps a global costmap (static layer from ``/map`` + obstacle layer from ``/scan`` +
 inflation), reads the robot pose from tf (``global_frame`` -> ``robot_base_frame``), plans with A*,
 replans every ``replan_period`` (Nav2's default behaviour tree replans at 1 Hz), follows the path
-with RPP at ``controller_frequency`` and publishes ``/cmd_vel`` and ``/plan``.
+at ``controller_frequency`` with the ``controller`` (``rpp``, the default, or ``mppi``; Nav2's plugin
+names are accepted too: see :mod:`._controllers`) and publishes ``/cmd_vel`` and ``/plan``.
 
 When blocked (collision ahead, no progress within ``movement_time_allowance``, no path) it runs
 Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle layer and replan,
@@ -38,6 +39,8 @@ from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
 from ._planner import Plan, PlanError, PlanFailure, plan
+from ._controllers import controller_name, declare_mppi_parameters
+from ._mppi import Mppi
 from ._rpp import RegulatedPurePursuit, RppParameters
 
 __all__ = ["NavigationFailure", "NavigationServer", "NavigationStatistics"]
@@ -136,6 +139,8 @@ class NavigationServer(Node):
         defaults.pop("extra")
         self.rpp_params = RppParameters(**{k: type(v)(d(k, v).value) for k, v in defaults.items() if k != "control_period"},
                                         control_period=1.0 / self.frequency)
+        self.controller = controller_name(str(d("controller", "rpp").value))
+        self.mppi_params = declare_mppi_parameters(self, 1.0 / self.frequency) if self.controller == "mppi" else None
         from aiorobot.msgs.geometry_msgs import Twist
         from aiorobot.msgs.nav2_msgs import ComputePathToPose, FollowWaypoints, NavigateThroughPoses, NavigateToPose
         from aiorobot.msgs.nav_msgs import OccupancyGrid, Path
@@ -156,7 +161,10 @@ class NavigationServer(Node):
         self._busy = False
         from ._kernels import warm_up
 
-        compile_kernels(self.get_logger(), lambda: warm_up("astar", "shortcut", "raytrace_clear"))  # not at the first goal
+        from ._mppi_kernels import warm_up as warm_up_mppi
+
+        compile_kernels(self.get_logger(), lambda: warm_up("astar", "shortcut", "raytrace_clear"),  # not at the first goal
+                        *([warm_up_mppi] if self.controller == "mppi" else []))
         self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
         self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)
@@ -387,7 +395,8 @@ class NavigationServer(Node):
         if self.localization_lost is not None:
             raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost}; not driving")
         goal = xyyaw(target)
-        rpp = RegulatedPurePursuit(self.rpp_params, self.costmap)
+        rpp: RegulatedPurePursuit | Mppi = (Mppi(self.mppi_params, self.costmap) if self.mppi_params is not None
+                                            else RegulatedPurePursuit(self.rpp_params, self.costmap))
         clock = self.get_clock()
         period = 1.0 / self.frequency
         last_plan_at = -math.inf
@@ -449,13 +458,13 @@ class NavigationServer(Node):
                 await self._recover(handle, f"no progress for {self.movement_time_allowance:g} s")
                 progress_ref, last_plan_at = (self._robot_pose(), t), -math.inf
                 continue
-            self._send(cmd.linear, cmd.angular)
+            self._send(cmd.linear, cmd.angular, getattr(cmd, "lateral", 0.0))  # MPPI's Omni model moves sideways
             speed = cmd.linear
             if feedback:
                 fb = action.Feedback()
                 fb.current_pose = pose_stamped(*pose, self.global_frame, self.now().to_msg())
                 fb.navigation_time = (self.now() - nav_start).to_msg()
-                dist = rpp._remaining(pose[0], pose[1])
+                dist = rpp.remaining(pose[0], pose[1])
                 fb.distance_remaining = float(dist)
                 fb.estimated_time_remaining = Duration(seconds=dist / max(abs(speed), 1e-3) if speed else 0.0).to_msg()
                 fb.number_of_recoveries = self.recoveries
@@ -493,10 +502,10 @@ class NavigationServer(Node):
                 await clock.sleep_for(1.0 / self.frequency)
         self._stop_base()
 
-    def _send(self, linear: float, angular: float) -> None:
+    def _send(self, linear: float, angular: float, lateral: float = 0.0) -> None:
         from aiorobot.msgs.geometry_msgs import Twist, Vector3
 
-        self.cmd_pub.publish(Twist(linear=Vector3(x=float(linear)), angular=Vector3(z=float(angular))))
+        self.cmd_pub.publish(Twist(linear=Vector3(x=float(linear), y=float(lateral)), angular=Vector3(z=float(angular))))
 
     def _stop_base(self) -> None:
         self._send(0.0, 0.0)
