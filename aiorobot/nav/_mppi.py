@@ -80,9 +80,12 @@ class Mppi:
         self._v = np.zeros((3, b, t))
         self._xs, self._ys, self._yaws = np.zeros((b, t)), np.zeros((b, t)), np.zeros((b, t))
         self._costs = np.zeros(b)
+        self._travelled = np.zeros(b)
         self._accel = np.array([p.ax_max, p.ax_min, p.ay_max, p.ay_min, p.az_max], dtype=np.float64)
         self._progress = 0
         self._xy_reached = False
+        #: ObstaclesCritic's distance by cost, for the costmap's (robot_radius, cost_scaling_factor, inflation_radius)
+        self._distances: tuple[tuple[float, float, float] | None, NDArray[np.float64]] = (None, np.zeros(256))
         self.reset()
 
     # -- state -----------------------------------------------------------------------------
@@ -223,7 +226,7 @@ class Mppi:
         if p.regenerate_noises:
             self._draw_noise()
         k.rollout(self._noise, cs, speed, pose, p.model_dt, self._accel, p.holonomic, self._cv, self._v,
-                  self._xs, self._ys, self._yaws)
+                  self._xs, self._ys, self._yaws, self._travelled)
         self._costs[:] = 0.0
         failed = self._score(pose, local)
         k.update_control_sequence(self._costs, self._cv, cs, p.gamma, self._std, p.temperature, p.holonomic)
@@ -267,7 +270,7 @@ class Mppi:
                 if length < c["threshold_to_consider"] or (name == "PathFollowCritic" and len(local) < 2):
                     continue
                 if furthest is None:
-                    furthest = int(k.furthest_reached_path_point(xs, ys, local, path_dist))
+                    furthest = int(k.furthest_reached_path_point(xs, ys, self._travelled, local, path_dist))
                 if valid is None:
                     valid = self._path_valid(local)
                 if name == "PathAlignCritic":
@@ -314,8 +317,11 @@ class Mppi:
         cm = self.costmap
         if cm is None:
             return False
+        key = (cm.robot_radius, cm.cost_scaling_factor, cm.inflation_radius)
+        if self._distances[0] != key:
+            self._distances = (key, k.obstacle_distances(*key))
         return bool(k.obstacles_critic(self._xs, self._ys, cm.cost, float(cm.origin[0]), float(cm.origin[1]),
-                                       float(cm.resolution), True, float(cm.robot_radius), float(cm.cost_scaling_factor),
+                                       float(cm.resolution), True, self._distances[1],
                                        float(cm.inflation_radius), float(c["collision_margin_distance"]),
                                        length < c["near_goal_distance"], float(c["critical_weight"]),
                                        float(c["repulsion_weight"]), float(c["collision_cost"]), int(c["cost_power"]),

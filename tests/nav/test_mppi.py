@@ -51,7 +51,8 @@ def test_rollout_integrates_with_the_previous_heading_and_limits_acceleration() 
     accel = np.array([2.0, -2.0, 2.0, -2.0, 1.0])
     cv, v = np.zeros((3, b, t)), np.zeros((3, b, t))
     xs, ys, yaws = np.zeros((b, t)), np.zeros((b, t)), np.zeros((b, t))
-    k.rollout(np.zeros((3, b, t)), cs, np.zeros(3), np.array([1.0, 2.0, 0.3]), dt, accel, False, cv, v, xs, ys, yaws)
+    travelled = np.zeros(b)
+    k.rollout(np.zeros((3, b, t)), cs, np.zeros(3), np.array([1.0, 2.0, 0.3]), dt, accel, False, cv, v, xs, ys, yaws, travelled)
     # step 0 is the current speed; each later step gains at most ax_max * dt = 0.2 m/s and az_max * dt = 0.1 rad/s
     np.testing.assert_allclose(v[0, 0], [0.0, 0.2, 0.4, 0.6, 0.8, 1.0])
     np.testing.assert_allclose(v[2, 0], [0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
@@ -61,7 +62,13 @@ def test_rollout_integrates_with_the_previous_heading_and_limits_acceleration() 
         x += v[0, 0, i] * math.cos(th) * dt
         y += v[0, 0, i] * math.sin(th) * dt
         th += v[2, 0, i] * dt
-        assert (xs[0, i], ys[0, i], yaws[0, i]) == pytest.approx((x, y, th))
+        assert (xs[0, i], ys[0, i], yaws[0, i]) == pytest.approx((x, y, th), abs=1e-12)
+    assert travelled[0] == pytest.approx(np.hypot(np.diff(xs[0]), np.diff(ys[0])).sum())
+    # a turn over 0.2 rad a step takes cos and sin: the same poses
+    cs[2], accel[4] = 8.0, 100.0
+    k.rollout(np.zeros((3, b, t)), cs, np.full(3, 8.0), np.zeros(3), dt, accel, False, cv, v, xs, ys, yaws, travelled)
+    th = np.cumsum(v[2, 0] * dt)
+    assert xs[0] == pytest.approx(np.cumsum(v[0, 0] * np.cos(np.concatenate(([0.0], th[:-1]))) * dt), abs=1e-12)
 
 
 def test_update_is_the_softmax_weighted_mean_of_the_noised_controls() -> None:
@@ -83,12 +90,13 @@ def test_obstacles_critic_scores_a_collision_and_flags_when_all_collide() -> Non
     xs = np.array([np.linspace(0.2, 0.6, 5), np.linspace(0.2, 1.4, 5)])
     ys = np.full((2, 5), 1.0)
     costs = np.zeros(2)
-    all_collide = k.obstacles_critic(xs, ys, cm.cost, 0.0, 0.0, 0.05, True, 0.22, 3.0, 0.55, 0.1, False, 20.0, 1.5,
+    dist = k.obstacle_distances(0.22, 3.0, 0.55)
+    all_collide = k.obstacles_critic(xs, ys, cm.cost, 0.0, 0.0, 0.05, True, dist, 0.55, 0.1, False, 20.0, 1.5,
                                      100000.0, 1, costs)
     assert not all_collide
     assert costs[1] >= 20.0 * 100000.0 and costs[0] < 1000.0
     costs[:] = 0.0
-    assert k.obstacles_critic(xs[1:], ys[1:], cm.cost, 0.0, 0.0, 0.05, True, 0.22, 3.0, 0.55, 0.1, False, 20.0, 1.5,
+    assert k.obstacles_critic(xs[1:], ys[1:], cm.cost, 0.0, 0.0, 0.05, True, dist, 0.55, 0.1, False, 20.0, 1.5,
                               100000.0, 1, costs[1:])
 
 
@@ -97,8 +105,9 @@ def test_furthest_reached_point_is_bounded_by_the_distance_travelled() -> None:
     dist = np.arange(len(path)) * 0.05
     xs = np.array([[0.0, 0.5, 1.0], [0.0, 0.1, 0.2]])
     ys = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])  # travels 2.0 m but ends at x = 0.2
-    assert k.furthest_reached_path_point(xs, ys, path, dist) == 20
-    assert k.furthest_reached_path_point(xs[1:], ys[1:], path, dist) == 4
+    travelled = np.array([1.0, 2.0])
+    assert k.furthest_reached_path_point(xs, ys, travelled, path, dist) == 20
+    assert k.furthest_reached_path_point(xs[1:], ys[1:], travelled[1:], path, dist) == 4
 
 
 # -- parameters --------------------------------------------------------------------------------
