@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from . import _mppi_kernels as k
 from ._costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION, Costmap
+from ._geometry import wrap_angle as _wrap
 from ._mppi_parameters import MppiParameters
 
 __all__ = ["Mppi", "MppiCommand"]
@@ -58,10 +59,6 @@ class MppiCommand:
     collision_ahead: bool = False
     #: the controller turns in place (no forward or sideways speed): progress checks let it be
     rotating: bool = False
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 class Mppi:
