@@ -44,7 +44,11 @@ def _near(name: str, names: Any) -> str:
 
 @dataclass
 class MppiParameters:
-    """nav2_mppi_controller's parameters (see the module doc); ``critic_params`` holds each critic's."""
+    """nav2_mppi_controller's parameters (see the module doc); ``critic_params`` holds each critic's.
+
+    rclpy difference: names are flat on the navigation server (no ``FollowPath.`` plugin prefix), a
+    positive ``ax_min``/``ay_min`` is refused rather than sign-flipped, and the noise is seeded.
+    """
 
     batch_size: int = 1000
     time_steps: int = 56
