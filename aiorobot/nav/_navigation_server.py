@@ -171,6 +171,10 @@ class NavigationServer(Node):
         self.create_action_server(ComputePathToPose, "compute_path_to_pose", self._compute_path, cancel_callback=_accept_cancel)
         self.last_plan: Plan | None = None
         self.recoveries = 0
+        from ._behaviors import Behaviors
+
+        #: Nav2's behavior, controller, planner, smoother and costmap interfaces (see _behaviors.py)
+        self.behaviors = Behaviors(self)
 
     def statistics(self) -> NavigationStatistics:
         """Recoveries of the current or last goal, whether one is running, the localisation state."""
@@ -395,8 +399,7 @@ class NavigationServer(Node):
         if self.localization_lost is not None:
             raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost}; not driving")
         goal = xyyaw(target)
-        rpp: RegulatedPurePursuit | Mppi = (Mppi(self.mppi_params, self.costmap) if self.mppi_params is not None
-                                            else RegulatedPurePursuit(self.rpp_params, self.costmap))
+        rpp = self._new_controller()
         clock = self.get_clock()
         period = 1.0 / self.frequency
         last_plan_at = -math.inf
@@ -501,6 +504,12 @@ class NavigationServer(Node):
                 self._send(0.0, speed)
                 await clock.sleep_for(1.0 / self.frequency)
         self._stop_base()
+
+    def _new_controller(self) -> RegulatedPurePursuit | Mppi:
+        """A fresh instance of the selected controller on the current costmap."""
+        if self.mppi_params is not None:
+            return Mppi(self.mppi_params, self.costmap)
+        return RegulatedPurePursuit(self.rpp_params, self.costmap)
 
     def _send(self, linear: float, angular: float, lateral: float = 0.0) -> None:
         from aiorobot.msgs.geometry_msgs import Twist, Vector3
