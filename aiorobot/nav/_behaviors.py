@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -52,6 +53,12 @@ def smooth_path(xy: NDArray[np.float64], *, w_data: float = 0.2, w_smooth: float
         if float(np.sum((out - before) ** 2)) < tolerance:
             break
     return out
+
+
+def _seconds(duration_msg: Any) -> float:
+    from aiorobot import Duration
+
+    return Duration.from_msg(duration_msg).nanoseconds / 1e9
 
 
 def _yaws(xy: NDArray[np.float64], last_yaw: float) -> NDArray[np.float64]:
@@ -100,47 +107,24 @@ class Behaviors:
     # -- behavior_server ---------------------------------------------------------------
 
     async def _spin(self, handle: Any) -> Any:
-        from aiorobot import Duration
         from aiorobot.msgs.nav2_msgs import Spin
 
-        s, goal, result = self.s, handle.request, Spin.Result()
-        allowance = Duration.from_msg(goal.time_allowance).nanoseconds / 1e9
-        try:
-            _, _, yaw0 = s._robot_pose()
-        except Exception as err:  # the server's TF_ERROR abort
-            return self._fail(handle, result, Spin.Result.TF_ERROR, str(err))
-        clock, period = s.get_clock(), 1.0 / s.frequency
-        turned, prev, speed, t = 0.0, yaw0, 0.0, 0.0
-        target = abs(float(goal.target_yaw))
-        sign = math.copysign(1.0, float(goal.target_yaw))
-        while turned < target - 1e-3:
-            if handle.is_cancel_requested:
-                handle.canceled()
-                return result
-            if allowance > 0 and t >= allowance:
-                return self._fail(handle, result, Spin.Result.TIMEOUT, f"spin: {turned:.2f} of {target:.2f} rad in the "
-                                  f"time allowance {allowance:g} s")
-            # Spin::onCycleUpdate: v = sqrt(2 a remaining), within [min, max]_rotational_vel
-            remaining = target - turned
-            speed = min(max(math.sqrt(2.0 * self.rotational_acc_lim * remaining), self.min_rotational_vel),
-                        self.max_rotational_vel, speed + self.rotational_acc_lim * period)
-            s._send(0.0, sign * speed)
-            handle.publish_feedback(Spin.Feedback(angular_distance_traveled=float(turned)))
-            await clock.sleep_for(period)
-            t += period
-            yaw = s._robot_pose()[2]
-            turned += abs(wrap_angle(yaw - prev))
-            prev = yaw
-        handle.succeed()
-        result.total_elapsed_time = Duration(seconds=t).to_msg()
-        return result
+        goal = handle.request
+        return await self._act(handle, Spin, self.spin(float(goal.target_yaw), _seconds(goal.time_allowance),
+                                                        feedback=lambda v: handle.publish_feedback(
+                                                            Spin.Feedback(angular_distance_traveled=v)),
+                                                        cancelled=lambda: handle.is_cancel_requested))
 
     async def _backup(self, handle: Any) -> Any:
         from aiorobot.msgs.nav2_msgs import BackUp
 
         goal = handle.request
         # BackUp::onRun: always backwards, whatever the signs given
-        return await self._straight(handle, BackUp, -abs(float(goal.target.x)), -abs(float(goal.speed)))
+        return await self._act(handle, BackUp, self.drive(-abs(float(goal.target.x)), -abs(float(goal.speed)),
+                                                          _seconds(goal.time_allowance),
+                                                          feedback=lambda v: handle.publish_feedback(
+                                                              BackUp.Feedback(distance_traveled=v)),
+                                                          cancelled=lambda: handle.is_cancel_requested))
 
     async def _drive_on_heading(self, handle: Any) -> Any:
         from aiorobot.msgs.nav2_msgs import DriveOnHeading
@@ -148,45 +132,100 @@ class Behaviors:
         goal = handle.request
         dist, speed = float(goal.target.x), float(goal.speed)
         if dist * speed <= 0.0 or goal.target.y != 0.0 or goal.target.z != 0.0:
-            result = DriveOnHeading.Result()
-            return self._fail(handle, result, DriveOnHeading.Result.INVALID_INPUT,
+            return self._fail(handle, DriveOnHeading.Result(), DriveOnHeading.Result.INVALID_INPUT,
                               f"drive_on_heading: expected target.x and speed of one sign, non-zero, and target.y = "
                               f"target.z = 0, found target ({goal.target.x:g}, {goal.target.y:g}, {goal.target.z:g}) "
                               f"and speed {speed:g}")
-        return await self._straight(handle, DriveOnHeading, dist, speed)
+        return await self._act(handle, DriveOnHeading, self.drive(dist, speed, _seconds(goal.time_allowance),
+                                                                  feedback=lambda v: handle.publish_feedback(
+                                                                      DriveOnHeading.Feedback(distance_traveled=v)),
+                                                                  cancelled=lambda: handle.is_cancel_requested))
 
-    async def _straight(self, handle: Any, action: Any, dist: float, speed: float) -> Any:
-        """DriveOnHeading's cycle: drive at ``speed`` until |dist| is covered, checking the line ahead."""
+    async def _act(self, handle: Any, action: Any, run: Any) -> Any:
+        """Await a behaviour's core and end its goal: succeeded, canceled, or aborted with Nav2's code."""
         from aiorobot import Duration
 
-        s, result = self.s, action.Result()
-        allowance = Duration.from_msg(handle.request.time_allowance).nanoseconds / 1e9
-        try:
-            x0, y0, _ = s._robot_pose()
-        except Exception as err:
-            return self._fail(handle, result, action.Result.TF_ERROR, str(err))
-        clock, period = s.get_clock(), 1.0 / s.frequency
-        t, travelled = 0.0, 0.0
-        while travelled < abs(dist):
-            if handle.is_cancel_requested:
-                handle.canceled()
-                return result
-            if allowance > 0 and t >= allowance:
-                return self._fail(handle, result, action.Result.TIMEOUT, f"{travelled:.2f} of {abs(dist):.2f} m in the "
-                                  f"time allowance {allowance:g} s")
-            x, y, yaw = s._robot_pose()
-            if self._blocked_ahead(x, y, yaw, speed, abs(dist) - travelled):
-                return self._fail(handle, result, action.Result.COLLISION_AHEAD,
-                                  f"collision ahead within {self.simulate_ahead_time:g} s at {abs(speed):g} m/s")
-            s._send(speed, 0.0)
-            handle.publish_feedback(action.Feedback(distance_traveled=float(travelled)))
-            await clock.sleep_for(period)
-            t += period
-            x, y, _ = s._robot_pose()
-            travelled = math.hypot(x - x0, y - y0)
-        handle.succeed()
-        result.total_elapsed_time = Duration(seconds=t).to_msg()
+        result = action.Result()
+        t0 = self.s.now()
+        outcome, message = await run
+        result.total_elapsed_time = Duration(nanoseconds=(self.s.now() - t0).nanoseconds).to_msg()
+        if outcome == "SUCCEEDED":
+            handle.succeed()
+        elif outcome == "CANCELED":
+            handle.canceled()
+        else:
+            self._fail(handle, result, getattr(action.Result, outcome), message)
         return result
+
+    # -- the behaviours' cores (the action servers above and the behaviour tree's leaves run these) --
+
+    async def spin(self, target_yaw: float, allowance: float, *, feedback: Callable[[float], None] | None = None,
+                   cancelled: Callable[[], bool] = lambda: False) -> tuple[str, str]:
+        """Turn by ``target_yaw`` (rad, + counter-clockwise) within ``allowance`` s (0: no limit).
+
+        Returns (``SUCCEEDED`` | ``CANCELED`` | a Spin result code name, a reason); the base stops at the end.
+        """
+        s = self.s
+        try:
+            try:
+                _, _, yaw0 = s._robot_pose()
+            except Exception as err:  # the server's TF_ERROR abort
+                return "TF_ERROR", str(err)
+            clock, period = s.get_clock(), 1.0 / s.frequency
+            turned, prev, speed, t = 0.0, yaw0, 0.0, 0.0
+            target = abs(float(target_yaw))
+            sign = math.copysign(1.0, float(target_yaw))
+            while turned < target - 1e-3:
+                if cancelled():
+                    return "CANCELED", "canceled"
+                if allowance > 0 and t >= allowance:
+                    return "TIMEOUT", f"spin: {turned:.2f} of {target:.2f} rad in the time allowance {allowance:g} s"
+                # Spin::onCycleUpdate: v = sqrt(2 a remaining), within [min, max]_rotational_vel
+                remaining = target - turned
+                speed = min(max(math.sqrt(2.0 * self.rotational_acc_lim * remaining), self.min_rotational_vel),
+                            self.max_rotational_vel, speed + self.rotational_acc_lim * period)
+                s._send(0.0, sign * speed)
+                if feedback is not None:
+                    feedback(float(turned))
+                await clock.sleep_for(period)
+                t += period
+                yaw = s._robot_pose()[2]
+                turned += abs(wrap_angle(yaw - prev))
+                prev = yaw
+            return "SUCCEEDED", ""
+        finally:
+            s._stop_base()
+
+    async def drive(self, dist: float, speed: float, allowance: float, *, feedback: Callable[[float], None] | None = None,
+                    cancelled: Callable[[], bool] = lambda: False) -> tuple[str, str]:
+        """DriveOnHeading's cycle: drive at ``speed`` (m/s; negative: backwards) until |``dist``| is covered,
+        checking the line ahead. Returns as :meth:`spin` (codes of DriveOnHeading / BackUp)."""
+        s = self.s
+        try:
+            try:
+                x0, y0, _ = s._robot_pose()
+            except Exception as err:
+                return "TF_ERROR", str(err)
+            clock, period = s.get_clock(), 1.0 / s.frequency
+            t, travelled = 0.0, 0.0
+            while travelled < abs(dist):
+                if cancelled():
+                    return "CANCELED", "canceled"
+                if allowance > 0 and t >= allowance:
+                    return "TIMEOUT", f"{travelled:.2f} of {abs(dist):.2f} m in the time allowance {allowance:g} s"
+                x, y, yaw = s._robot_pose()
+                if self._blocked_ahead(x, y, yaw, speed, abs(dist) - travelled):
+                    return "COLLISION_AHEAD", f"collision ahead within {self.simulate_ahead_time:g} s at {abs(speed):g} m/s"
+                s._send(speed, 0.0)
+                if feedback is not None:
+                    feedback(float(travelled))
+                await clock.sleep_for(period)
+                t += period
+                x, y, _ = s._robot_pose()
+                travelled = math.hypot(x - x0, y - y0)
+            return "SUCCEEDED", ""
+        finally:
+            s._stop_base()
 
     def _blocked_ahead(self, x: float, y: float, yaw: float, speed: float, remaining: float) -> bool:
         """DriveOnHeading::isCollisionFree: poses along the line, up to simulate_ahead_time (and no
@@ -216,49 +255,70 @@ class Behaviors:
         from aiorobot.msgs.nav2_msgs import FollowPath
 
         s, result = self.s, FollowPath.Result()
-        poses = [xyyaw(p) for p in handle.request.path.poses]
-        if not poses:
+        poses = np.array([xyyaw(p) for p in handle.request.path.poses], dtype=np.float64).reshape(-1, 3)
+        if not len(poses):
             return self._fail(handle, result, FollowPath.Result.INVALID_PATH, "follow_path: the path has no poses")
         try:
             await s._wait_for_map()
             await s._wait_for_robot_pose()
         except Exception as err:
             return self._fail(handle, result, FollowPath.Result.TF_ERROR, str(err))
+        outcome, message = await self.follow(lambda: poses, feedback=lambda d, v: handle.publish_feedback(
+            FollowPath.Feedback(distance_to_goal=d, speed=v)), cancelled=lambda: handle.is_cancel_requested)
+        if outcome == "SUCCEEDED":
+            handle.succeed()
+        elif outcome == "CANCELED":
+            handle.canceled()
+        else:
+            self._fail(handle, result, getattr(FollowPath.Result, outcome), message)
+        return result
+
+    async def follow(self, path: Callable[[], NDArray[np.float64]], *, feedback: Callable[[float, float], None] | None = None,
+                     cancelled: Callable[[], bool] = lambda: False) -> tuple[str, str]:
+        """controller_server's loop: the selected controller along ``path()`` (N, 3), taken up again
+        whenever it returns a new array, until the goal checker is satisfied. The progress checker
+        (``required_movement_radius`` in ``movement_time_allowance``) and a second of no
+        collision-free command fail it. Returns as :meth:`spin` (codes of FollowPath)."""
+        s = self.s
         controller = s._new_controller()
-        controller.set_plan(np.array(poses, dtype=np.float64))
+        current = path()
+        controller.set_plan(current)
         clock, period = s.get_clock(), 1.0 / s.frequency
         t, speed = 0.0, 0.0
         ref_pose, ref_t = s._robot_pose(), 0.0
         blocked_since: float | None = None
-        while True:
-            if handle.is_cancel_requested:
-                handle.canceled()
-                return result
-            pose = s._robot_pose()
-            cmd = controller.step(pose, speed)
-            if cmd.goal_reached:
-                handle.succeed()
-                return result
-            if cmd.collision_ahead:
-                blocked_since = t if blocked_since is None else blocked_since
-                if t - blocked_since >= 1.0:
-                    return self._fail(handle, result, FollowPath.Result.NO_VALID_CONTROL,
-                                      "follow_path: no collision-free command for 1 s")
-            else:
-                blocked_since = None
-            # SimpleProgressChecker
-            if math.hypot(pose[0] - ref_pose[0], pose[1] - ref_pose[1]) >= s.required_movement_radius or cmd.rotating:
-                ref_pose, ref_t = pose, t
-            elif t - ref_t >= s.movement_time_allowance:
-                return self._fail(handle, result, FollowPath.Result.FAILED_TO_MAKE_PROGRESS,
-                                  f"follow_path: moved less than {s.required_movement_radius:g} m in "
-                                  f"{s.movement_time_allowance:g} s")
-            s._send(cmd.linear, cmd.angular, getattr(cmd, "lateral", 0.0))
-            speed = cmd.linear
-            handle.publish_feedback(FollowPath.Feedback(distance_to_goal=float(controller.remaining(pose[0], pose[1])),
-                                                        speed=float(math.hypot(cmd.linear, getattr(cmd, "lateral", 0.0)))))
-            await clock.sleep_for(period)
-            t += period
+        try:
+            while True:
+                if cancelled():
+                    return "CANCELED", "canceled"
+                if path() is not current:  # a new plan: the same controller takes it up (Nav2's setPlan)
+                    current = path()
+                    controller.set_plan(current)
+                pose = s._robot_pose()
+                cmd = controller.step(pose, speed)
+                if cmd.goal_reached:
+                    return "SUCCEEDED", ""
+                if cmd.collision_ahead:
+                    blocked_since = t if blocked_since is None else blocked_since
+                    if t - blocked_since >= 1.0:
+                        return "NO_VALID_CONTROL", "no collision-free command for 1 s"
+                else:
+                    blocked_since = None
+                # SimpleProgressChecker
+                if math.hypot(pose[0] - ref_pose[0], pose[1] - ref_pose[1]) >= s.required_movement_radius or cmd.rotating:
+                    ref_pose, ref_t = pose, t
+                elif t - ref_t >= s.movement_time_allowance:
+                    return "FAILED_TO_MAKE_PROGRESS", (f"moved less than {s.required_movement_radius:g} m in "
+                                                       f"{s.movement_time_allowance:g} s")
+                lateral = getattr(cmd, "lateral", 0.0)
+                s._send(cmd.linear, cmd.angular, lateral)
+                speed = cmd.linear
+                if feedback is not None:
+                    feedback(float(controller.remaining(pose[0], pose[1])), float(math.hypot(cmd.linear, lateral)))
+                await clock.sleep_for(period)
+                t += period
+        finally:
+            s._stop_base()
 
     # -- planner_server and smoother_server ------------------------------------------------
 
