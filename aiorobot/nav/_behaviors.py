@@ -172,6 +172,7 @@ class Behaviors:
             except Exception as err:  # the server's TF_ERROR abort
                 return "TF_ERROR", str(err)
             clock, period = s.get_clock(), 1.0 / s.frequency
+            start = clock.now()
             turned, prev, speed, t = 0.0, yaw0, 0.0, 0.0
             target = abs(float(target_yaw))
             sign = math.copysign(1.0, float(target_yaw))
@@ -188,7 +189,7 @@ class Behaviors:
                 if feedback is not None:
                     feedback(float(turned))
                 await clock.sleep_for(period)
-                t += period
+                t = (clock.now() - start).nanoseconds / 1e9  # a sleep may outlast its period on sim time
                 yaw = s._robot_pose()[2]
                 turned += abs(wrap_angle(yaw - prev))
                 prev = yaw
@@ -207,6 +208,7 @@ class Behaviors:
             except Exception as err:
                 return "TF_ERROR", str(err)
             clock, period = s.get_clock(), 1.0 / s.frequency
+            start = clock.now()
             t, travelled = 0.0, 0.0
             while travelled < abs(dist):
                 if cancelled():
@@ -220,7 +222,7 @@ class Behaviors:
                 if feedback is not None:
                     feedback(float(travelled))
                 await clock.sleep_for(period)
-                t += period
+                t = (clock.now() - start).nanoseconds / 1e9  # a sleep may outlast its period on sim time
                 x, y, _ = s._robot_pose()
                 travelled = math.hypot(x - x0, y - y0)
             return "SUCCEEDED", ""
@@ -284,6 +286,7 @@ class Behaviors:
         current = path()
         controller.set_plan(current)
         clock, period = s.get_clock(), 1.0 / s.frequency
+        start = clock.now()
         t, speed = 0.0, 0.0
         ref_pose, ref_t = s._robot_pose(), 0.0
         blocked_since: float | None = None
@@ -316,7 +319,7 @@ class Behaviors:
                 if feedback is not None:
                     feedback(float(controller.remaining(pose[0], pose[1])), float(math.hypot(cmd.linear, lateral)))
                 await clock.sleep_for(period)
-                t += period
+                t = (clock.now() - start).nanoseconds / 1e9  # a sleep may outlast its period on sim time
         finally:
             s._stop_base()
 

@@ -7,11 +7,15 @@ replans every ``replan_period`` (Nav2's default behaviour tree replans at 1 Hz),
 at ``controller_frequency`` with the ``controller`` (``rpp``, the default, or ``mppi``; Nav2's plugin
 names are accepted too: see :mod:`._controllers`) and publishes ``/cmd_vel`` and ``/plan``.
 
-When blocked (collision ahead, no progress within ``movement_time_allowance``, no path) it runs
-Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle layer and replan,
-wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason. A goal outside the
-map or in an obstacle is aborted at once with Nav2's error code and message; a cancel stops the
-base and ends CANCELED; no ``/map`` within ``map_timeout`` aborts.
+Each pose runs a behaviour tree, as Nav2's bt_navigator does (:mod:`._bt_navigator`): Nav2's
+default NavigateToPose tree unless ``default_nav_to_pose_bt_xml`` or the goal's ``behavior_tree``
+names another BehaviorTree.CPP XML file. When blocked (no collision-free command for a second, no
+progress within ``movement_time_allowance``, no path) the default tree runs Nav2's recoveries in
+turn, counting ``number_of_recoveries``: clear the costmap, spin ``spin_dist``, wait
+``wait_duration``, back up ``backup_dist`` at ``backup_speed``; past ``max_recoveries`` the goal is
+aborted with the reason. A goal outside the map or in an obstacle is aborted at once with Nav2's
+error code and message; a cancel stops the base and ends CANCELED; no ``/map`` within
+``map_timeout`` aborts; a tree that cannot be loaded aborts with FAILED_TO_LOAD_BEHAVIOR_TREE.
 
 Localisation lost: the pose estimate on ``localization_topic`` (AMCL's ``amcl_pose``, a
 PoseWithCovarianceStamped; ``localization_type = "odometry"`` for an EKF's nav_msgs/Odometry) with a position standard deviation above
@@ -57,6 +61,7 @@ class NavigationFailure(enum.Enum):
     """
 
     UNKNOWN = 9000
+    FAILED_TO_LOAD_BEHAVIOR_TREE = 9001
     TF_ERROR = 9002
 
     @property
@@ -73,8 +78,6 @@ def _plan_code(kind: PlanFailure) -> int:
     return int(getattr(ComputePathToPose.Result, kind.name))
 
 
-#: planner failures no recovery helps with: the goal or the start is off the map, or the goal is occupied
-_HOPELESS = (PlanFailure.START_OUTSIDE_MAP, PlanFailure.GOAL_OUTSIDE_MAP, PlanFailure.GOAL_OCCUPIED)
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,10 +101,11 @@ def _accept_cancel(_handle: Any) -> Any:
 class _Abort(Exception):
     """A goal ends aborted: ``kind`` says why, ``code`` is its nav2_msgs result code."""
 
-    def __init__(self, kind: NavigationFailure | PlanFailure, message: str) -> None:
+    def __init__(self, kind: NavigationFailure | PlanFailure, message: str, code: int | None = None) -> None:
         super().__init__(message)
         self.kind = kind
-        self.code = _plan_code(kind) if isinstance(kind, PlanFailure) else kind.code
+        #: ``code`` given: another server's result code (a behaviour tree leaf's error_code_id)
+        self.code = code if code is not None else _plan_code(kind) if isinstance(kind, PlanFailure) else kind.code
 
 
 class NavigationServer(Node):
@@ -130,6 +134,10 @@ class NavigationServer(Node):
         self.max_localization_std = float(d("max_localization_std", 0.5).value)
         self.max_localization_yaw_std = float(d("max_localization_yaw_std", 0.8).value)
         self.localization_recovery_timeout = float(d("localization_recovery_timeout", 5.0).value)
+        #: bt_navigator's: the tree for a goal that names none ('' = Nav2's default tree), and the tick period (ms)
+        self.default_bt_xml = str(d("default_nav_to_pose_bt_xml", "").value)
+        self.bt_loop_duration = int(d("bt_loop_duration", 10).value) / 1000.0
+        self.last_speed = 0.0
         self.costmap_params = {
             "robot_radius": float(d("robot_radius", 0.22).value),
             "inflation_radius": float(d("inflation_radius", 0.55).value),
@@ -391,119 +399,10 @@ class NavigationServer(Node):
         return msg
 
     async def _drive_to(self, handle: Any, target: Any, action: Any, nav_start: Any, *, remaining: int, feedback: bool = True) -> bool:
-        """Drive to one pose; True on arrival, False when canceled; raises _Abort with the reason."""
-        from aiorobot import Duration
+        """Drive to one pose with the behaviour tree; True on arrival, False when canceled; raises _Abort with the reason."""
+        from ._bt_navigator import navigate_with_tree
 
-        await self._wait_for_map()
-        await self._wait_for_robot_pose()
-        if self.localization_lost is not None:
-            raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost}; not driving")
-        goal = xyyaw(target)
-        rpp = self._new_controller()
-        clock = self.get_clock()
-        period = 1.0 / self.frequency
-        last_plan_at = -math.inf
-        blocked_since: float | None = None
-        progress_ref = (self._robot_pose(), 0.0)
-        speed = 0.0
-        t = 0.0  # seconds on the node's clock since this pose began
-        first_plan = True
-        lost_since: float | None = None
-        while True:
-            if handle.is_cancel_requested:
-                self._stop_base()
-                return False
-            if self.localization_lost is not None:
-                self._stop_base()
-                if lost_since is None:
-                    lost_since = t
-                    self.get_logger().warning(f"localisation lost ({self.localization_lost}): stopped; waiting up to "
-                                              f"{self.localization_recovery_timeout:g} s for it to come back")
-                if t - lost_since >= self.localization_recovery_timeout:
-                    raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost} for "
-                                                            f"{self.localization_recovery_timeout:g} s")
-                await clock.sleep_for(period)
-                t += period
-                progress_ref = (progress_ref[0], t)  # standing still for this is not a lack of progress
-                continue
-            if lost_since is not None:
-                self.get_logger().info("localisation back: driving on")
-                lost_since, last_plan_at = None, -math.inf
-            pose = self._robot_pose()
-            if t - last_plan_at >= self.replan_period:
-                try:
-                    rpp.set_plan(self._plan(pose, goal).poses)
-                except _Abort as err:
-                    if first_plan and err.kind in _HOPELESS:
-                        raise  # outside the map / occupied: no recovery helps
-                    await self._recover(handle, f"no path ({err})")
-                    progress_ref = (self._robot_pose(), t)
-                    continue
-                first_plan = False
-                last_plan_at = t
-            cmd = rpp.step(pose, speed)
-            if cmd.goal_reached:
-                self._stop_base()
-                return True
-            if cmd.collision_ahead:
-                blocked_since = t if blocked_since is None else blocked_since
-                if t - blocked_since >= 1.0:
-                    await self._recover(handle, "collision ahead")
-                    blocked_since, last_plan_at = None, -math.inf
-                    progress_ref = (self._robot_pose(), t)
-                    continue
-            else:
-                blocked_since = None
-            ref_pose, ref_t = progress_ref
-            if math.hypot(pose[0] - ref_pose[0], pose[1] - ref_pose[1]) >= self.required_movement_radius or cmd.rotating:
-                progress_ref = (pose, t)
-            elif t - ref_t >= self.movement_time_allowance:
-                await self._recover(handle, f"no progress for {self.movement_time_allowance:g} s")
-                progress_ref, last_plan_at = (self._robot_pose(), t), -math.inf
-                continue
-            self._send(cmd.linear, cmd.angular, getattr(cmd, "lateral", 0.0))  # MPPI's Omni model moves sideways
-            speed = cmd.linear
-            if feedback:
-                fb = action.Feedback()
-                fb.current_pose = pose_stamped(*pose, self.global_frame, self.now().to_msg())
-                fb.navigation_time = (self.now() - nav_start).to_msg()
-                dist = rpp.remaining(pose[0], pose[1])
-                fb.distance_remaining = float(dist)
-                fb.estimated_time_remaining = Duration(seconds=dist / max(abs(speed), 1e-3) if speed else 0.0).to_msg()
-                fb.number_of_recoveries = self.recoveries
-                if hasattr(fb, "number_of_poses_remaining"):
-                    fb.number_of_poses_remaining = remaining
-                handle.publish_feedback(fb)
-            await clock.sleep_for(period)
-            t += period
-
-    async def _recover(self, handle: Any, why: str) -> None:
-        """Nav2's recoveries in turn: clear + wait, back up, spin; abort when the budget is spent."""
-        if self.recoveries >= self.max_recoveries:
-            raise _Abort(NavigationFailure.UNKNOWN, f"blocked ({why}) and {self.max_recoveries} recoveries did not help")
-        kind = ("clear_and_wait", "backup", "spin")[self.recoveries % 3]
-        self.recoveries += 1
-        self.get_logger().info(f"recovery {self.recoveries}/{self.max_recoveries}: {kind} ({why})")
-        clock = self.get_clock()
-        self._stop_base()
-        if kind == "clear_and_wait" and self.costmap is not None:
-            self.costmap.clear_obstacles()
-            self.costmap.update()
-            await clock.sleep_for(self.wait_duration)
-        elif kind == "backup":
-            for _ in range(int(self.backup_dist / self.backup_speed * self.frequency)):
-                if handle.is_cancel_requested:
-                    break
-                self._send(-self.backup_speed, 0.0)
-                await clock.sleep_for(1.0 / self.frequency)
-        else:
-            speed = self.rpp_params.rotate_to_heading_angular_vel
-            for _ in range(int(self.spin_dist / speed * self.frequency)):
-                if handle.is_cancel_requested:
-                    break
-                self._send(0.0, speed)
-                await clock.sleep_for(1.0 / self.frequency)
-        self._stop_base()
+        return await navigate_with_tree(self, handle, target, action, nav_start, remaining=remaining, feedback=feedback)
 
     def _new_controller(self) -> RegulatedPurePursuit | Mppi:
         """A fresh instance of the selected controller on the current costmap."""
@@ -514,6 +413,7 @@ class NavigationServer(Node):
     def _send(self, linear: float, angular: float, lateral: float = 0.0) -> None:
         from aiorobot.msgs.geometry_msgs import Twist, Vector3
 
+        self.last_speed = float(math.hypot(linear, lateral))
         self.cmd_pub.publish(Twist(linear=Vector3(x=float(linear), y=float(lateral)), angular=Vector3(z=float(angular))))
 
     def _stop_base(self) -> None:
