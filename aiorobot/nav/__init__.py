@@ -30,6 +30,7 @@ from ._landmark_map import (
     save_landmark_map,
 )
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
+from ._lifecycle_manager import LifecycleManager, LifecycleManagerStatistics, ManagerState
 from ._map_server import MapServer
 from ._mppi import Mppi, MppiCommand
 from ._mppi_parameters import CRITICS as MPPI_CRITICS, MOTION_MODELS as MPPI_MOTION_MODELS, MppiParameters
@@ -51,6 +52,9 @@ __all__ = [
     "base_pose_from_marker",
     "base_pose_from_markers",
     "map_from_marker",
+    "LifecycleManager",
+    "LifecycleManagerStatistics",
+    "ManagerState",
     "MapServer",
     "Mppi",
     "MppiCommand",

@@ -16,9 +16,9 @@ Every method also answers to BasicNavigator's camelCase name (``goToPose``, ``sp
 Tasks (one at a time, as BasicNavigator): navigate to / through poses, follow waypoints, spin,
 back up, drive on a heading, follow a path; ``is_task_complete``, ``get_feedback``, ``get_result``
 and ``cancel_task`` apply to whichever runs. Queries: a path to a pose or through poses, a smoothed
-path, the costmaps; commands: clear the costmaps, change the map. Not here: the lifecycle calls
-(``lifecycleStartup`` / ``lifecycleShutdown``: aiorobot's navigation nodes are not lifecycle nodes),
-GPS waypoints, routes, docking, following, assisted teleop and the collision monitor toggle.
+path, the costmaps; commands: clear the costmaps, change the map, start up or shut down every
+lifecycle manager's nodes. Not here: GPS waypoints, routes, docking, following, assisted teleop and
+the collision monitor toggle.
 """
 
 from __future__ import annotations
@@ -281,6 +281,33 @@ class Navigator(Node):
 
     # -- start-up ---------------------------------------------------------------------------
 
+    async def lifecycle_startup(self) -> None:
+        """STARTUP on every lifecycle manager in the graph (each ``*/manage_nodes`` service), as BasicNavigator."""
+        await self._manage_all("STARTUP")
+
+    async def lifecycle_shutdown(self) -> None:
+        """SHUTDOWN on every lifecycle manager in the graph."""
+        await self._manage_all("SHUTDOWN")
+
+    async def _manage_all(self, command: str) -> None:
+        from aiorobot.msgs.nav2_msgs import ManageLifecycleNodes
+
+        found = [name for name, types in self.get_service_names_and_types()
+                 if "nav2_msgs/srv/ManageLifecycleNodes" in types]
+        if not found:
+            self.get_logger().warning(f"lifecycle {command.lower()}: no lifecycle manager (ManageLifecycleNodes service) "
+                                      "in the graph")
+        for name in found:
+            self.get_logger().info(f"{command} on {name}")
+            client = self.create_client(ManageLifecycleNodes, name)
+            try:
+                response = await self._call(client, name, ManageLifecycleNodes.Request(
+                    command=getattr(ManageLifecycleNodes.Request, command)))
+                if response is not None and not response.success:
+                    self.get_logger().error(f"{name}: {command} failed")
+            finally:
+                self.destroy_client(client)
+
     async def wait_until_nav2_active(self, navigator: str = "bt_navigator", localizer: str = "amcl",
                                      timeout_sec: float | None = None) -> None:
         """Wait until navigation can take goals: the navigate_to_pose server is up and, with ``localizer``
@@ -326,3 +353,5 @@ class Navigator(Node):
     getLocalCostmap = get_local_costmap  # noqa: N815
     changeMap = change_map  # noqa: N815
     waitUntilNav2Active = wait_until_nav2_active  # noqa: N815
+    lifecycleStartup = lifecycle_startup  # noqa: N815
+    lifecycleShutdown = lifecycle_shutdown  # noqa: N815
