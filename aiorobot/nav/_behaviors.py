@@ -148,7 +148,8 @@ class Behaviors:
         result = action.Result()
         t0 = self.s.now()
         outcome, message = await run
-        result.total_elapsed_time = Duration(nanoseconds=(self.s.now() - t0).nanoseconds).to_msg()
+        if hasattr(result, "total_elapsed_time"):
+            result.total_elapsed_time = Duration(nanoseconds=(self.s.now() - t0).nanoseconds).to_msg()
         if outcome == "SUCCEEDED":
             handle.succeed()
         elif outcome == "CANCELED":
@@ -265,15 +266,8 @@ class Behaviors:
             await s._wait_for_robot_pose()
         except Exception as err:
             return self._fail(handle, result, FollowPath.Result.TF_ERROR, str(err))
-        outcome, message = await self.follow(lambda: poses, feedback=lambda d, v: handle.publish_feedback(
-            FollowPath.Feedback(distance_to_goal=d, speed=v)), cancelled=lambda: handle.is_cancel_requested)
-        if outcome == "SUCCEEDED":
-            handle.succeed()
-        elif outcome == "CANCELED":
-            handle.canceled()
-        else:
-            self._fail(handle, result, getattr(FollowPath.Result, outcome), message)
-        return result
+        return await self._act(handle, FollowPath, self.follow(lambda: poses, feedback=lambda d, v: handle.publish_feedback(
+            FollowPath.Feedback(distance_to_goal=d, speed=v)), cancelled=lambda: handle.is_cancel_requested))
 
     async def follow(self, path: Callable[[], NDArray[np.float64]], *, feedback: Callable[[float, float], None] | None = None,
                      cancelled: Callable[[], bool] = lambda: False) -> tuple[str, str]:

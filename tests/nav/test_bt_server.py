@@ -13,7 +13,7 @@ import pytest
 from aiorobot.nav import LETHAL_OBSTACLE, MapServer, NavigationServer, Navigator, TaskResult, pose_stamped
 from aiorobot.testing import SimClock
 
-from .test_navigation_e2e import KinematicRobot
+from .test_navigation_e2e import KinematicRobot, _until
 
 
 def _room_with_a_closed_box(tmp: Path) -> Path:
@@ -38,13 +38,6 @@ async def world(sim_runtime, tmp_path):
     nav = sim_runtime.add_node(Navigator())
     await sim.advance(0.2, step_sec=0.02)
     return sim, robot, server, nav
-
-
-async def _until(sim: SimClock, nav: Navigator, limit_sec: float) -> None:
-    t = 0.0
-    while not nav.is_task_complete() and t < limit_sec:
-        await sim.advance(0.1, step_sec=0.05)
-        t += 0.1
 
 
 async def test_stale_obstacles_across_the_room_are_cleared_by_the_planner_recovery(world) -> None:

@@ -15,7 +15,7 @@ from aiorobot.nav import LETHAL_OBSTACLE, MapServer, NavigationServer, Navigator
 from aiorobot.nav._behaviors import smooth_path
 from aiorobot.testing import SimClock
 
-from .test_navigation_e2e import KinematicRobot, _room
+from .test_navigation_e2e import KinematicRobot, _room, _until
 
 
 @pytest.fixture
@@ -28,13 +28,6 @@ async def world(sim_runtime, tmp_path):
     nav = sim_runtime.add_node(Navigator())
     await sim.advance(0.2, step_sec=0.02)
     return sim, robot, server, nav, maps
-
-
-async def _until(sim: SimClock, nav: Navigator, limit_sec: float) -> None:
-    t = 0.0
-    while not nav.isTaskComplete() and t < limit_sec:
-        await sim.advance(0.1, step_sec=0.05)
-        t += 0.1
 
 
 async def _answer(sim: SimClock, coro):
