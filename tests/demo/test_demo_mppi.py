@@ -15,10 +15,10 @@ pytestmark = pytest.mark.timeout(300)
 
 
 async def test_a_box_mission_with_mppi_reaches_its_waypoints_without_collision() -> None:
-    summary = await run_demo("box", [(1.5, 0.0, math.pi / 2), (1.5, 1.5, math.pi)], seed=3, timeout_sim_sec=120.0,
+    summary = await run_demo("box", [(1.5, 0.0, math.pi / 2)], seed=3, timeout_sim_sec=60.0,
                              perception=False, controller="mppi")
     assert summary.controller == "mppi" and summary.figures()["controller"] == "mppi"
-    assert summary.waypoints_reached == 2 and summary.collisions == 0, summary.figures()
+    assert summary.waypoints_reached == 1 and summary.collisions == 0, summary.figures()
     assert summary.succeeded and not summary.failures
 
 
