@@ -78,8 +78,6 @@ def _plan_code(kind: PlanFailure) -> int:
     return int(getattr(ComputePathToPose.Result, kind.name))
 
 
-
-
 @dataclass(frozen=True, slots=True)
 class NavigationStatistics:
     """What :meth:`NavigationServer.statistics` reports (a snapshot)."""
