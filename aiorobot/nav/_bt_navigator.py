@@ -54,7 +54,7 @@ async def navigate_with_tree(server: Any, handle: Any, target: Any, action: Any,
     """
     from aiorobot import Duration
 
-    from ._navigation_server import NavigationFailure, _Abort
+    from ._navigation_server import NavigationFailure, _Abort, _Preempted
 
     s = server
     await s._wait_for_map()
@@ -79,6 +79,8 @@ async def navigate_with_tree(server: Any, handle: Any, target: Any, action: Any,
             t = (clock.now() - start).nanoseconds / 1e9  # a sleep may last longer than asked (sim time steps)
             if handle.is_cancel_requested:
                 return False
+            if s._preempt:
+                raise _Preempted()
             if s.localization_lost is not None:
                 tree.halt()
                 s._stop_base()

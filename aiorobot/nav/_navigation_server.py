@@ -106,6 +106,13 @@ class _Abort(Exception):
         self.code = code if code is not None else _plan_code(kind) if isinstance(kind, PlanFailure) else kind.code
 
 
+class _Preempted(_Abort):
+    """The running goal gives way to a newer one of the same action (Nav2's SimpleActionServer aborts it)."""
+
+    def __init__(self) -> None:
+        super().__init__(NavigationFailure.UNKNOWN, "preempted by a newer goal")
+
+
 class NavigationServer(Node):
     """Nav2's navigation actions in one node (parameters keep Nav2's names; see the module doc)."""
 
@@ -171,9 +178,13 @@ class NavigationServer(Node):
 
         compile_kernels(self.get_logger(), lambda: warm_up("astar", "shortcut", "raytrace_clear"),  # not at the first goal
                         *([warm_up_mppi] if self.controller == "mppi" else []))
-        self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
-        self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
-        self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)
+        #: the navigation action running ('' none) and whether a newer goal of it is waiting to take over
+        self._running, self._preempt, self._latest = "", False, object()
+        for action, name, run in ((NavigateToPose, "navigate_to_pose", self._navigate_to_pose),
+                                  (NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses),
+                                  (FollowWaypoints, "follow_waypoints", self._follow_waypoints)):
+            self.create_action_server(action, name, self._preempting(name, action, run), goal_callback=self._accept_or_preempt(name),
+                                      cancel_callback=_accept_cancel)
         self.create_action_server(ComputePathToPose, "compute_path_to_pose", self._compute_path, cancel_callback=_accept_cancel)
         self.last_plan: Plan | None = None
         self.recoveries = 0
@@ -249,6 +260,39 @@ class NavigationServer(Node):
 
         return GoalResponse.REJECT if self._busy else GoalResponse.ACCEPT
 
+    def _accept_or_preempt(self, name: str) -> Any:
+        """A navigation action's goal callback: a goal of the running action preempts it (Nav2's
+        SimpleActionServer: the running goal is aborted and the new one runs); others wait their turn."""
+
+        def accept(goal: Any) -> Any:
+            from aiorobot import GoalResponse
+
+            if not self._busy:
+                return GoalResponse.ACCEPT
+            if self._running == name:
+                self._preempt = True
+                return GoalResponse.ACCEPT
+            return GoalResponse.REJECT
+
+        return accept
+
+    def _preempting(self, name: str, action: Any, run: Any) -> Any:
+        async def execute(handle: Any) -> Any:
+            clock = self.get_clock()
+            self._latest = token = object()
+            while self._busy:  # the preempted goal ends at its next tick
+                await clock.sleep_for(0.01)
+            if self._latest is not token:  # a still newer goal came while this one waited
+                handle.abort()
+                return action.Result(error_code=NavigationFailure.UNKNOWN.code, error_msg="preempted by a newer goal")
+            self._preempt, self._running = False, name
+            try:
+                return await run(handle)
+            finally:
+                self._running = ""
+
+        return execute
+
     # -- actions ------------------------------------------------------------------------
 
     async def _navigate_to_pose(self, handle: Any) -> Any:
@@ -309,6 +353,11 @@ class NavigationServer(Node):
                             handle.canceled()
                             result.missed_waypoints = missed
                             return result
+                    except _Preempted as err:
+                        handle.abort()
+                        self.get_logger().warning(f"waypoint following {err}")
+                        result.missed_waypoints = missed
+                        return result
                     except _Abort as err:
                         missed.append(MissedWaypoint(index=i, goal=poses[i], error_code=err.code))
                         self.get_logger().warning(f"waypoint {i} missed: {err}")

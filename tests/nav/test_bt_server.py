@@ -87,3 +87,16 @@ async def test_a_goal_can_name_its_own_tree_and_a_bad_one_fails_with_nav2s_code(
     assert await nav.go_to_pose(pose_stamped(1.2, -1.0, 0.0), behavior_tree=str(tmp_path / "missing.xml"))
     await _until(sim, nav, 5.0)
     assert nav.get_result() is TaskResult.FAILED and "missing.xml: cannot read the behaviour tree" in nav.result.error_msg
+
+
+async def test_a_newer_goal_preempts_the_running_one_of_the_same_action(world, sim_runtime) -> None:
+    sim, robot, server, nav = world
+    other = sim_runtime.add_node(Navigator("second_navigator"))
+    assert await nav.go_to_pose(pose_stamped(-1.2, 1.2, 0.0))
+    await sim.advance(1.0, step_sec=0.05)
+    assert not await other.follow_waypoints([pose_stamped(-1.5, -1.0, 0.0)])  # another action waits its turn: refused
+    assert await other.go_to_pose(pose_stamped(-0.5, -1.0, 0.0))  # the same action: takes over
+    await _until(sim, other, 30.0)
+    assert other.get_result() is TaskResult.SUCCEEDED
+    assert nav.get_result() is TaskResult.FAILED and nav.result.error_msg == "preempted by a newer goal"
+    assert math.hypot(robot.pose[0] + 0.5, robot.pose[1] + 1.0) <= 0.25
