@@ -333,6 +333,8 @@ class Behaviors:
                               "compute_path_through_poses: no goals given")
         try:
             await s._wait_for_map()
+            if not req.use_start:
+                await s._wait_for_robot_pose()  # a planner asked at start-up waits for tf, up to transform_timeout
             start = xyyaw(req.start) if req.use_start else s._robot_pose()
             legs = []
             for goal in req.goals:

@@ -380,6 +380,8 @@ class NavigationServer(Node):
         t0 = time.perf_counter()
         try:
             await self._wait_for_map()
+            if not req.use_start:
+                await self._wait_for_robot_pose()  # a planner asked at start-up waits for tf, up to transform_timeout
             start = xyyaw(req.start) if req.use_start else self._robot_pose()
             p = self._plan(start, xyyaw(req.goal))
             result.path = self._path_msg(p)

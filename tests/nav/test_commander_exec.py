@@ -136,7 +136,7 @@ def test_a_program_written_as_nav2s_examples_reaches_its_goals_under_aiorobot_ex
     proc = subprocess.run([sys.executable, "-m", "aiorobot.cli", "exec", "--node", "stack:Robot", "--node", "stack:Map",
                            "--node", "stack:Nav", str(tmp_path / "program.py")],
                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=110)
-    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-3000:]
     out = proc.stdout
     assert "follow_path SUCCEEDED" in out and "go_to_pose SUCCEEDED" in out and "waypoints SUCCEEDED 1" in out, out
     assert "wall FAILED (206, 'the goal (2.90, 0.00) is in or too close to an obstacle" in out, out
