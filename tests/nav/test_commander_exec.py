@@ -19,43 +19,25 @@ import pytest
 pytestmark = pytest.mark.timeout(120)
 
 STACK = '''
-import math
-from aiorobot import Node
 from aiorobot.nav import MapServer, NavigationServer
-from aiorobot.nav._geometry import yaw_quaternion
+from tests.nav.test_navigation_e2e import KinematicRobot
 
 MAP = {map!r}
 
 
-class Robot(Node):
-    """Integrates /cmd_vel and says where it is: map -> base_link, and amcl_pose as a perfect AMCL would."""
+class Robot(KinematicRobot):
+    """The e2e tests' kinematic robot, saying where it is on amcl_pose too, as a perfect AMCL would."""
 
-    def __init__(self, **kw):
-        super().__init__("robot", **kw)
-        from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped, Twist
-        from aiorobot.tf import TransformBroadcaster
+    def __init__(self):
+        super().__init__()
+        from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
 
-        self.pose, self.cmd, self.last = [0.0, 0.0, 0.0], (0.0, 0.0), None
-        self.tf = TransformBroadcaster(self)
-        self.create_subscription(Twist, "/cmd_vel", lambda m: setattr(self, "cmd", (m.linear.x, m.angular.z)), 10)
         self.estimate = self.create_publisher(PoseWithCovarianceStamped, "amcl_pose", 10)
-        self.create_timer(0.02, self.step)
 
     def step(self):
-        from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped, TransformStamped
+        from aiorobot.msgs.geometry_msgs import PoseWithCovarianceStamped
 
-        now = self.now().nanoseconds
-        dt = 0.0 if self.last is None else (now - self.last) / 1e9
-        self.last = now
-        v, w = self.cmd
-        self.pose[0] += v * math.cos(self.pose[2]) * dt
-        self.pose[1] += v * math.sin(self.pose[2]) * dt
-        self.pose[2] += w * dt
-        t = TransformStamped()
-        t.header.frame_id, t.child_frame_id, t.header.stamp = "map", "base_link", self.now().to_msg()
-        t.transform.translation.x, t.transform.translation.y = self.pose[0], self.pose[1]
-        t.transform.rotation = yaw_quaternion(self.pose[2])
-        self.tf.send_transform(t)
+        super().step()
         m = PoseWithCovarianceStamped()
         m.header.frame_id = "map"
         m.pose.pose.position.x, m.pose.pose.position.y = self.pose[0], self.pose[1]
@@ -64,13 +46,13 @@ class Robot(Node):
 
 
 class Map(MapServer):
-    def __init__(self, **kw):
-        super().__init__(yaml_filename=MAP, **kw)
+    def __init__(self):
+        super().__init__(yaml_filename=MAP)
 
 
 class Nav(NavigationServer):
-    def __init__(self, **kw):
-        super().__init__(parameter_overrides={{"desired_linear_vel": 0.8}}, **kw)
+    def __init__(self):
+        super().__init__(parameter_overrides={{"desired_linear_vel": 0.8}})
 '''
 
 PROGRAM = '''
@@ -132,7 +114,8 @@ def test_a_program_written_as_nav2s_examples_reaches_its_goals_under_aiorobot_ex
                                         "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
     (tmp_path / "stack.py").write_text(STACK.format(map=str(tmp_path / "room.yaml")))
     (tmp_path / "program.py").write_text(textwrap.dedent(PROGRAM))
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    root = Path(__file__).resolve().parents[2]  # the stack reuses tests.nav.test_navigation_e2e's robot
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(root), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.run([sys.executable, "-m", "aiorobot.cli", "exec", "--node", "stack:Robot", "--node", "stack:Map",
                            "--node", "stack:Nav", str(tmp_path / "program.py")],
                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=110)
