@@ -51,7 +51,11 @@ class LifecycleManagerStatistics:
 
 
 class LifecycleManager(Node):
-    """See the module doc."""
+    """See the module doc.
+
+    rclpy difference: liveliness is a ``get_state`` poll every ``bond_heartbeat_period``, not a bond;
+    the node found down is left out of the hard reset.
+    """
 
     def __init__(self, node_name: str = "lifecycle_manager", **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
