@@ -8,6 +8,8 @@
 - SLAM (issue 30's targets): a scan match of 360 beams at 0.05 m against ten scans of the warehouse
   (and at the default 0.025 m), the loop-closure optimisation of a 500-node graph, and a whole
   mapping run of the warehouse loop (simulated lidar included) as a real-time factor.
+- one MPPI control cycle with Nav2's defaults (batch_size 1000, time_steps 56, eight critics) on
+  that costmap, the robot driven along the serpentine's plan by the commands.
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ def _grid() -> np.ndarray:
 
 
 def run(quick: bool = False) -> dict[str, Any]:
-    from aiorobot.nav import Amcl, AmclParameters, Costmap, RegulatedPurePursuit, plan
+    from aiorobot.nav import Amcl, AmclParameters, Costmap, Mppi, MppiParameters, RegulatedPurePursuit, plan
 
     n = 5 if quick else 30
     static = _grid()
@@ -81,6 +83,18 @@ def run(quick: bool = False) -> dict[str, Any]:
     path = plan(cm, (0.5, 0.5), (19.5, 19.5)).poses
     rpp.set_plan(path)
     out["rpp_step_us"] = _timed(lambda: rpp.step((float(path[0, 0]), float(path[0, 1]), float(path[0, 2])), 0.3), n * 10)
+    mppi = Mppi(MppiParameters(batch_size=1000, time_steps=56), cm)
+    mppi.set_plan(path)
+    pose = [float(path[0, 0]), float(path[0, 1]), float(path[0, 2])]
+
+    def mppi_cycle() -> None:
+        c = mppi.step((pose[0], pose[1], pose[2]), mppi.last_command[0])
+        dt = mppi.p.controller_period
+        pose[0] += c.linear * math.cos(pose[2]) * dt
+        pose[1] += c.linear * math.sin(pose[2]) * dt
+        pose[2] += c.angular * dt
+
+    out["mppi_cycle_us"] = _timed(mppi_cycle, n * 10)
     out["collision_monitor_scan_us"] = _timed(_collision_monitor_step(), n * 10)
     out.update(_slam(quick))
     return out
@@ -165,6 +179,7 @@ def table(part: dict[str, Any]) -> Any:
         ("AMCL update, 500 particles x 60 beams (target <= 5 ms)", part["amcl_500x60_us"]),
         ("costmap update from one 360-beam scan (target <= 2 ms)", part["costmap_scan_update_us"]),
         ("Regulated Pure Pursuit step", part["rpp_step_us"]),
+        ("MPPI control cycle, 1000 x 56 (target <= 20 ms p99)", part["mppi_cycle_us"]),
         ("SLAM scan match, 360 beams at 0.05 m (target <= 5 ms)", part["slam_match_005_us"]),
         ("SLAM scan match, 360 beams at the default 0.025 m", part["slam_match_default_us"]),
         ("SLAM loop-closure optimisation, 500 nodes (target <= 50 ms)", part["slam_optimise_500_us"]),

@@ -67,6 +67,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "localises on it; the planner plans on the growing map (unknown space allowed). The summary "
                         "adds the map's agreement with the world and the loop closures; --plot draws the built map "
                         "over the true one")
+    parser.add_argument("--controller", choices=("rpp", "mppi"), default="rpp",
+                        help="the navigation server's path follower: rpp, Regulated Pure Pursuit (default); mppi, "
+                        "nav2_mppi_controller's sampling controller")
     parser.add_argument("--no-perception", dest="perception", action="store_false",
                         help="leave out the camera, ArUco and lidar-obstacle perception (needs --localisation amcl)")
     parser.add_argument("--realtime", action="store_true",
@@ -134,7 +137,7 @@ def main(args: argparse.Namespace) -> int:
     if start.warning is not None:
         print(f"aiorobot demo: warning: {start.warning}", file=sys.stderr)
     print(f"aiorobot demo: {args.world}, {len(waypoints)} waypoints, mecanum robot ({drive} drive), "
-          f"{localisation} localisation, seed {args.seed}, "
+          f"{localisation} localisation, {args.controller} controller, seed {args.seed}, "
           f"{'as fast as possible' if args.rtf == 0 else f'real-time factor {args.rtf:g}'}, {time_source} time"
           f"{f', {args.duration:g} sim s' if args.duration else ''} (Ctrl-C stops)", file=sys.stderr)
     try:
@@ -143,7 +146,7 @@ def main(args: argparse.Namespace) -> int:
                                         record=str(args.record) if args.record else None,
                                         timeout_sim_sec=args.timeout, progress=progress,
                                         time_source=args.time_source, realtime=args.realtime,
-                                        start=start.pose, duration_sim_sec=args.duration))
+                                        start=start.pose, duration_sim_sec=args.duration, controller=args.controller))
     except DemoSetupError as err:  # a node refused what the checks above let through (nothing started)
         print(f"aiorobot demo: error: {err}", file=sys.stderr)
         return 2
@@ -171,7 +174,7 @@ def _print_summary(s: object) -> None:
     outcome = (f"stopped after --duration: {f['waypoints_reached']} / {f['waypoints_total']} waypoints"
                if f["stopped_by_duration"] else f["status"])
     world = Path(f["world"]).name  # a map path by its file name
-    title = f"aiorobot demo — {world}, {f['drive']} drive, {f['localisation']}: {outcome}"
+    title = f"aiorobot demo — {world}, {f['drive']} drive, {f['localisation']}, {f['controller']}: {outcome}"
     table = Table()
     table.add_column("figure")
     table.add_column("value", justify="right")

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["DRIVES", "LOCALISATIONS", "ROBOT_RADIUS", "WORLD_MAP_TOPIC", "DemoGraph", "build_graph", "time_source_for"]
+__all__ = ["CONTROLLERS", "DRIVES", "LOCALISATIONS", "ROBOT_RADIUS", "WORLD_MAP_TOPIC", "DemoGraph", "build_graph", "time_source_for"]
 
 #: ``direct``: the simulator follows /cmd_vel (lock-step possible); ``serial``: the simulated
 #: ESP32 firmware on a pty, through SerialMotorBridge and MecanumController (real time only).
@@ -33,6 +33,8 @@ DRIVES = ("direct", "serial")
 LOCALISATIONS = ("amcl", "landmarks", "slam")
 #: where the simulator's world map goes under ``slam``: /map is SLAM's
 WORLD_MAP_TOPIC = "/world/map"
+#: the navigation server's ``controller``: Regulated Pure Pursuit or MPPI (nav2_mppi_controller)
+CONTROLLERS = ("rpp", "mppi")
 #: The simulated robot's footprint radius (m): the simulator's default, what a start or a waypoint must leave free.
 ROBOT_RADIUS = 0.22
 #: The demo's graph: every node it may run, with the parameters no option changes (build_graph picks and adds).
@@ -109,12 +111,13 @@ def build_graph(
     record: str | None = None,
     time_source: str | None = None,
     start: tuple[float, float, float] | None = None,
+    controller: str = "rpp",
 ) -> DemoGraph:
     """Construct the demo's nodes (not yet added to a runtime) for ``world`` (a loaded World).
 
     ``start`` (x, y, yaw in map) is where the robot starts and where localisation begins; None
     takes :func:`~aiorobot.sim.resolve_start`'s choice (the world's start, or the free cell
-    nearest it).
+    nearest it). ``controller`` is the navigation server's (:data:`CONTROLLERS`).
 
     ``time_source`` (``sim`` or ``system``, the simulator's parameter) defaults to
     :func:`time_source_for` ``(rtf)``; the runtime must use sim time exactly when it is ``sim``.
@@ -124,6 +127,8 @@ def build_graph(
 
     if drive not in DRIVES:
         raise ValueError(f"drive: expected one of {', '.join(DRIVES)}, found {drive!r}")
+    if controller not in CONTROLLERS:
+        raise ValueError(f"controller: expected one of {', '.join(CONTROLLERS)}, found {controller!r}")
     if localisation not in LOCALISATIONS:
         raise ValueError(f"localisation: expected one of {', '.join(LOCALISATIONS)}, found {localisation!r}")
     if drive == "serial" and rtf == 0.0:
@@ -147,7 +152,7 @@ def build_graph(
             "start": list(start), "robot_radius": ROBOT_RADIUS,
         },
         "ekf_local": {},
-        "navigation_server": {},
+        "navigation_server": {"controller": controller},
         "collision_monitor": {},
     }
     if drive == "serial":

@@ -84,6 +84,8 @@ class DemoSummary:
     real_time_factor: float = 0.0
     drive: str = "direct"
     localisation: str = "amcl"
+    #: the navigation server's path follower: ``rpp`` or ``mppi``
+    controller: str = "rpp"
     #: ``sim`` (the simulator's /clock) or ``system`` (system-time stamps, at real-time factor 1)
     time_source: str = "sim"
     #: the priority loop's control timer whose periods are measured (wall clock x rtf; None in lock-step)
@@ -313,6 +315,7 @@ async def run_demo(
     realtime: bool = False,
     start: tuple[float, float, float] | None = None,
     duration_sim_sec: float | None = None,
+    controller: str = "rpp",
 ) -> DemoSummary:
     """Run the mission; return its summary. ``rtf = 0`` runs as fast as the machine allows.
 
@@ -324,6 +327,7 @@ async def run_demo(
     ``drive`` is ``"serial"`` (the simulated ESP32 firmware on a pty; needs ``rtf > 0``) or
     ``"direct"`` (the simulator follows /cmd_vel); None picks serial when ``rtf > 0``.
     ``localisation`` is ``"amcl"`` or ``"landmarks"`` (ArUco fixes into the map-frame EKF).
+    ``controller`` is the navigation server's path follower, ``"rpp"`` or ``"mppi"``.
     ``record`` is a directory for a rosbag2/MCAP bag of the run's topics (raw images excluded).
     ``realtime`` runs the priority loop's thread SCHED_FIFO where the OS permits it (as ros2_control's
     controller manager does); otherwise a warning, and the run goes on.
@@ -353,13 +357,13 @@ async def run_demo(
             if localisation == "slam":
                 waypoints.append(choice.pose)  # home: SLAM closes the loop where it began
         graph = build_graph(loaded, rtf=rtf, seed=seed, drive=drive, localisation=localisation, perception=perception,
-                            record=record, time_source=time_source, start=choice.pose)
+                            record=record, time_source=time_source, start=choice.pose, controller=controller)
     except ValueError as err:  # WorldError and the nodes' parameter errors among them
         raise DemoSetupError(str(err)) from err
     if choice.warning is not None:
         logging.getLogger("aiorobot.demo").warning(choice.warning)
     summary = DemoSummary(world=world, waypoints_total=len(waypoints), real_time_factor=rtf, drive=drive,
-                          localisation=localisation, time_source=graph.time_source, start=choice.pose,
+                          localisation=localisation, controller=controller, time_source=graph.time_source, start=choice.pose,
                           duration_sec=duration_sim_sec)
     # What exists now (imported modules, Numba's and the simulator's start-up objects: most of the heap) is
     # left out of the cyclic collector's full passes: such a pass stops every thread, the priority loop's

@@ -1,8 +1,9 @@
-"""Navigation: costmaps, planning, Regulated Pure Pursuit, AMCL localisation, the collision monitor,
-online SLAM (pure cores).
+"""Navigation: costmaps, planning, Regulated Pure Pursuit, MPPI, AMCL localisation, the collision
+monitor, online SLAM (pure cores).
 
 Cores follow Nav2's definitions and parameter names (nav2_costmap_2d, NavFn/Smac 2D,
-nav2_regulated_pure_pursuit_controller, nav2_amcl, nav2_collision_monitor, slam_toolbox) on numpy arrays, with Numba kernels where
+nav2_regulated_pure_pursuit_controller, nav2_mppi_controller, nav2_amcl, nav2_collision_monitor,
+slam_toolbox) on numpy arrays, with Numba kernels where
 they loop; they are tested without a runtime.
 """
 
@@ -35,7 +36,10 @@ from ._landmark_map import (
     save_landmark_map,
 )
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
+from ._lifecycle_manager import LifecycleManager, LifecycleManagerStatistics, ManagerState
 from ._map_server import MapServer
+from ._mppi import Mppi, MppiCommand
+from ._mppi_parameters import CRITICS as MPPI_CRITICS, MOTION_MODELS as MPPI_MOTION_MODELS, MppiParameters
 from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
 from ._navigator import Navigator, TaskResult
@@ -68,7 +72,15 @@ __all__ = [
     "base_pose_from_marker",
     "base_pose_from_markers",
     "map_from_marker",
+    "LifecycleManager",
+    "LifecycleManagerStatistics",
+    "ManagerState",
     "MapServer",
+    "Mppi",
+    "MppiCommand",
+    "MppiParameters",
+    "MPPI_CRITICS",
+    "MPPI_MOTION_MODELS",
     "MappingNode",
     "OccupancyMapper",
     "NavigationFailure",

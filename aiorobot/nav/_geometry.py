@@ -5,7 +5,12 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["pose_stamped", "transform_to_xyyaw", "xyyaw", "yaw_quaternion"]
+__all__ = ["pose_stamped", "transform_to_xyyaw", "wrap_angle", "xyyaw", "yaw_quaternion"]
+
+
+def wrap_angle(a: float) -> float:
+    """``a`` (rad) wrapped into [-pi, pi) (angles::normalize_angle, but -pi for +pi)."""
+    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 def yaw_quaternion(yaw: float) -> Any:

@@ -1,28 +1,33 @@
 """``NavigationServer``: Nav2's navigate_to_pose, navigate_through_poses, follow_waypoints and
-compute_path_to_pose actions over the pure cores (costmap, planner, Regulated Pure Pursuit).
+compute_path_to_pose actions over the pure cores (costmap, planner, Regulated Pure Pursuit or MPPI).
 
 It keeps a global costmap (static layer from ``/map`` + obstacle layer from ``/scan`` +
 inflation), reads the robot pose from tf (``global_frame`` -> ``robot_base_frame``), plans with A*,
 replans every ``replan_period`` (Nav2's default behaviour tree replans at 1 Hz), follows the path
-with RPP at ``controller_frequency`` and publishes ``/cmd_vel`` and ``/plan``.
+at ``controller_frequency`` with the ``controller`` (``rpp``, the default, or ``mppi``; Nav2's plugin
+names are accepted too: see :mod:`._controllers`) and publishes ``/cmd_vel`` and ``/plan``.
 
 The robot's shape is Nav2's costmap parameters ``footprint`` (a polygon ``"[[x, y], ...]"``, padded
 by ``footprint_padding``) or ``robot_radius``: the costmap inflates by its inscribed radius, and the
-planner and RPP's collision check test the footprint at each pose.
+planner and the controller's collision check test the footprint at each pose.
 
 Costmap filters as Nav2's (``filters``, each with its ``plugin`` and ``filter_info_topic``): a
-keepout mask makes its cells obstacles for the planner, a speed mask caps RPP's speed where the
-robot is (see :mod:`aiorobot.nav._filter_inputs`).
+keepout mask makes its cells obstacles for the planner, a speed mask caps the controller's speed
+where the robot is (see :mod:`aiorobot.nav._filter_inputs`).
 
-When blocked (collision ahead, no progress within ``movement_time_allowance``, no path) it runs
-Nav2's recoveries in turn, counting ``number_of_recoveries``: clear the obstacle layer and replan,
-wait, back up, spin; past ``max_recoveries`` the goal is aborted with the reason. A goal outside the
-map or in an obstacle is aborted at once with Nav2's error code and message; a cancel stops the
-base and ends CANCELED; no ``/map`` within ``map_timeout`` aborts.
+Each pose runs a behaviour tree, as Nav2's bt_navigator does (:mod:`._bt_navigator`): Nav2's
+default NavigateToPose tree unless ``default_nav_to_pose_bt_xml`` or the goal's ``behavior_tree``
+names another BehaviorTree.CPP XML file. When blocked (no collision-free command for a second, no
+progress within ``movement_time_allowance``, no path) the default tree runs Nav2's recoveries in
+turn, counting ``number_of_recoveries``: clear the costmap, spin ``spin_dist``, wait
+``wait_duration``, back up ``backup_dist`` at ``backup_speed``; past ``max_recoveries`` the goal is
+aborted with the reason. A goal outside the map or in an obstacle is aborted at once with Nav2's
+error code and message; a cancel stops the base and ends CANCELED; no ``/map`` within
+``map_timeout`` aborts; a tree that cannot be loaded aborts with FAILED_TO_LOAD_BEHAVIOR_TREE.
 
 A ``geometry_msgs/PoseStamped`` on ``goal_pose`` (the topic RViz's and Foxglove's "2D Goal Pose"
 publish) is sent as a ``navigate_to_pose`` goal to this node's own action server, as Nav2's
-bt_navigator does; a goal refused (one is already running) is logged.
+bt_navigator does (a running goal is preempted by it; a refused one is logged).
 
 Localisation lost: the pose estimate on ``localization_topic`` (AMCL's ``amcl_pose``, a
 PoseWithCovarianceStamped; ``localization_type = "odometry"`` for an EKF's nav_msgs/Odometry) with a position standard deviation above
@@ -51,6 +56,8 @@ from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
 from ._planner import Plan, PlanError, PlanFailure, plan
+from ._controllers import controller_name, declare_mppi_parameters
+from ._mppi import Mppi
 from ._rpp import RegulatedPurePursuit, RppParameters
 
 __all__ = ["NavigationFailure", "NavigationServer", "NavigationStatistics"]
@@ -67,6 +74,7 @@ class NavigationFailure(enum.Enum):
     """
 
     UNKNOWN = 9000
+    FAILED_TO_LOAD_BEHAVIOR_TREE = 9001
     TF_ERROR = 9002
 
     @property
@@ -81,10 +89,6 @@ def _plan_code(kind: PlanFailure) -> int:
     from aiorobot.msgs.nav2_msgs import ComputePathToPose
 
     return int(getattr(ComputePathToPose.Result, kind.name))
-
-
-#: planner failures no recovery helps with: the goal or the start is off the map, or the goal is occupied
-_HOPELESS = (PlanFailure.START_OUTSIDE_MAP, PlanFailure.GOAL_OUTSIDE_MAP, PlanFailure.GOAL_OCCUPIED)
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,10 +112,18 @@ def _accept_cancel(_handle: Any) -> Any:
 class _Abort(Exception):
     """A goal ends aborted: ``kind`` says why, ``code`` is its nav2_msgs result code."""
 
-    def __init__(self, kind: NavigationFailure | PlanFailure, message: str) -> None:
+    def __init__(self, kind: NavigationFailure | PlanFailure, message: str, code: int | None = None) -> None:
         super().__init__(message)
         self.kind = kind
-        self.code = _plan_code(kind) if isinstance(kind, PlanFailure) else kind.code
+        #: ``code`` given: another server's result code (a behaviour tree leaf's error_code_id)
+        self.code = code if code is not None else _plan_code(kind) if isinstance(kind, PlanFailure) else kind.code
+
+
+class _Preempted(_Abort):
+    """The running goal gives way to a newer one of the same action (Nav2's SimpleActionServer aborts it)."""
+
+    def __init__(self) -> None:
+        super().__init__(NavigationFailure.UNKNOWN, "preempted by a newer goal")
 
 
 class NavigationServer(Node):
@@ -140,6 +152,10 @@ class NavigationServer(Node):
         self.max_localization_std = float(d("max_localization_std", 0.5).value)
         self.max_localization_yaw_std = float(d("max_localization_yaw_std", 0.8).value)
         self.localization_recovery_timeout = float(d("localization_recovery_timeout", 5.0).value)
+        #: bt_navigator's: the tree for a goal that names none ('' = Nav2's default tree), and the tick period (ms)
+        self.default_bt_xml = str(d("default_nav_to_pose_bt_xml", "").value)
+        self.bt_loop_duration = int(d("bt_loop_duration", 10).value) / 1000.0
+        self.last_speed = 0.0
         from ._footprint import Footprint
 
         robot_radius = float(d("robot_radius", 0.22).value)
@@ -157,6 +173,8 @@ class NavigationServer(Node):
         defaults.pop("extra")
         self.rpp_params = RppParameters(**{k: type(v)(d(k, v).value) for k, v in defaults.items() if k != "control_period"},
                                         control_period=1.0 / self.frequency)
+        self.controller = controller_name(str(d("controller", "rpp").value))
+        self.mppi_params = declare_mppi_parameters(self, 1.0 / self.frequency) if self.controller == "mppi" else None
         from aiorobot.msgs.geometry_msgs import Twist
         from aiorobot.msgs.nav2_msgs import ComputePathToPose, FollowWaypoints, NavigateThroughPoses, NavigateToPose
         from aiorobot.msgs.nav_msgs import OccupancyGrid, Path
@@ -179,15 +197,21 @@ class NavigationServer(Node):
         from ._footprint import warm_up as warm_up_footprint
         from ._kernels import warm_up
 
+        from ._mppi_kernels import warm_up as warm_up_mppi
+
         def warm() -> None:  # not at the first goal
             warm_up("astar", "shortcut", "raytrace_clear")
             if not footprint.is_circular:
                 warm_up_footprint()
 
-        compile_kernels(self.get_logger(), warm)
-        self.create_action_server(NavigateToPose, "navigate_to_pose", self._navigate_to_pose, goal_callback=self._accept, cancel_callback=_accept_cancel)
-        self.create_action_server(NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses, goal_callback=self._accept, cancel_callback=_accept_cancel)
-        self.create_action_server(FollowWaypoints, "follow_waypoints", self._follow_waypoints, goal_callback=self._accept, cancel_callback=_accept_cancel)
+        compile_kernels(self.get_logger(), warm, *([warm_up_mppi] if self.controller == "mppi" else []))
+        #: the navigation action running ('' none) and whether a newer goal of it is waiting to take over
+        self._running, self._preempt, self._latest = "", False, object()
+        for action, name, run in ((NavigateToPose, "navigate_to_pose", self._navigate_to_pose),
+                                  (NavigateThroughPoses, "navigate_through_poses", self._navigate_through_poses),
+                                  (FollowWaypoints, "follow_waypoints", self._follow_waypoints)):
+            self.create_action_server(action, name, self._preempting(name, action, run), goal_callback=self._accept_or_preempt(name),
+                                      cancel_callback=_accept_cancel)
         self.create_action_server(ComputePathToPose, "compute_path_to_pose", self._compute_path, cancel_callback=_accept_cancel)
         self._self_client = self.create_action_client(NavigateToPose, "navigate_to_pose")
         from aiorobot.msgs.geometry_msgs import PoseStamped
@@ -195,6 +219,10 @@ class NavigationServer(Node):
         self.create_subscription(PoseStamped, "goal_pose", self._on_goal_pose, 10)
         self.last_plan: Plan | None = None
         self.recoveries = 0
+        from ._behaviors import Behaviors
+
+        #: Nav2's behavior, controller, planner, smoother and costmap interfaces (see _behaviors.py)
+        self.behaviors = Behaviors(self)
 
     def statistics(self) -> NavigationStatistics:
         """Recoveries of the current or last goal, whether one is running, the localisation state."""
@@ -270,7 +298,40 @@ class NavigationServer(Node):
 
         handle = await self._self_client.send_goal(NavigateToPose.Goal(pose=pose))
         if not handle.accepted:
-            self.get_logger().warning("goal_pose: navigate_to_pose refused the goal (one is already running)")
+            self.get_logger().warning("goal_pose: navigate_to_pose refused the goal")
+
+    def _accept_or_preempt(self, name: str) -> Any:
+        """A navigation action's goal callback: a goal of the running action preempts it (Nav2's
+        SimpleActionServer: the running goal is aborted and the new one runs); others wait their turn."""
+
+        def accept(goal: Any) -> Any:
+            from aiorobot import GoalResponse
+
+            if not self._busy:
+                return GoalResponse.ACCEPT
+            if self._running == name:
+                self._preempt = True
+                return GoalResponse.ACCEPT
+            return GoalResponse.REJECT
+
+        return accept
+
+    def _preempting(self, name: str, action: Any, run: Any) -> Any:
+        async def execute(handle: Any) -> Any:
+            clock = self.get_clock()
+            self._latest = token = object()
+            while self._busy:  # the preempted goal ends at its next tick
+                await clock.sleep_for(0.01)
+            if self._latest is not token:  # a still newer goal came while this one waited
+                handle.abort()
+                return action.Result(error_code=NavigationFailure.UNKNOWN.code, error_msg="preempted by a newer goal")
+            self._preempt, self._running = False, name
+            try:
+                return await run(handle)
+            finally:
+                self._running = ""
+
+        return execute
 
     # -- actions ------------------------------------------------------------------------
 
@@ -332,6 +393,11 @@ class NavigationServer(Node):
                             handle.canceled()
                             result.missed_waypoints = missed
                             return result
+                    except _Preempted as err:
+                        handle.abort()
+                        self.get_logger().warning(f"waypoint following {err}")
+                        result.missed_waypoints = missed
+                        return result
                     except _Abort as err:
                         missed.append(MissedWaypoint(index=i, goal=poses[i], error_code=err.code))
                         self.get_logger().warning(f"waypoint {i} missed: {err}")
@@ -354,6 +420,8 @@ class NavigationServer(Node):
         t0 = time.perf_counter()
         try:
             await self._wait_for_map()
+            if not req.use_start:
+                await self._wait_for_robot_pose()  # a planner asked at start-up waits for tf, up to transform_timeout
             start = xyyaw(req.start) if req.use_start else self._robot_pose()
             p = self._plan(start, xyyaw(req.goal))
             result.path = self._path_msg(p)
@@ -420,125 +488,22 @@ class NavigationServer(Node):
         return msg
 
     async def _drive_to(self, handle: Any, target: Any, action: Any, nav_start: Any, *, remaining: int, feedback: bool = True) -> bool:
-        """Drive to one pose; True on arrival, False when canceled; raises _Abort with the reason."""
-        from aiorobot import Duration
+        """Drive to one pose with the behaviour tree; True on arrival, False when canceled; raises _Abort with the reason."""
+        from ._bt_navigator import navigate_with_tree
 
-        await self._wait_for_map()
-        await self._wait_for_robot_pose()
-        if self.localization_lost is not None:
-            raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost}; not driving")
-        goal = xyyaw(target)
-        rpp = RegulatedPurePursuit(self.rpp_params, self.costmap)
-        clock = self.get_clock()
-        period = 1.0 / self.frequency
-        last_plan_at = -math.inf
-        blocked_since: float | None = None
-        progress_ref = (self._robot_pose(), 0.0)
-        speed = 0.0
-        t = 0.0  # seconds on the node's clock since this pose began
-        first_plan = True
-        lost_since: float | None = None
-        while True:
-            if handle.is_cancel_requested:
-                self._stop_base()
-                return False
-            if self.localization_lost is not None:
-                self._stop_base()
-                if lost_since is None:
-                    lost_since = t
-                    self.get_logger().warning(f"localisation lost ({self.localization_lost}): stopped; waiting up to "
-                                              f"{self.localization_recovery_timeout:g} s for it to come back")
-                if t - lost_since >= self.localization_recovery_timeout:
-                    raise _Abort(NavigationFailure.UNKNOWN, f"localisation lost: {self.localization_lost} for "
-                                                            f"{self.localization_recovery_timeout:g} s")
-                await clock.sleep_for(period)
-                t += period
-                progress_ref = (progress_ref[0], t)  # standing still for this is not a lack of progress
-                continue
-            if lost_since is not None:
-                self.get_logger().info("localisation back: driving on")
-                lost_since, last_plan_at = None, -math.inf
-            pose = self._robot_pose()
-            if t - last_plan_at >= self.replan_period:
-                try:
-                    rpp.set_plan(self._plan(pose, goal).poses)
-                except _Abort as err:
-                    if first_plan and err.kind in _HOPELESS:
-                        raise  # outside the map / occupied: no recovery helps
-                    await self._recover(handle, f"no path ({err})")
-                    progress_ref = (self._robot_pose(), t)
-                    continue
-                first_plan = False
-                last_plan_at = t
-            self.filters.update(rpp, pose[0], pose[1])
-            cmd = rpp.step(pose, speed)
-            if cmd.goal_reached:
-                self._stop_base()
-                return True
-            if cmd.collision_ahead:
-                blocked_since = t if blocked_since is None else blocked_since
-                if t - blocked_since >= 1.0:
-                    await self._recover(handle, "collision ahead")
-                    blocked_since, last_plan_at = None, -math.inf
-                    progress_ref = (self._robot_pose(), t)
-                    continue
-            else:
-                blocked_since = None
-            ref_pose, ref_t = progress_ref
-            if math.hypot(pose[0] - ref_pose[0], pose[1] - ref_pose[1]) >= self.required_movement_radius or cmd.rotating:
-                progress_ref = (pose, t)
-            elif t - ref_t >= self.movement_time_allowance:
-                await self._recover(handle, f"no progress for {self.movement_time_allowance:g} s")
-                progress_ref, last_plan_at = (self._robot_pose(), t), -math.inf
-                continue
-            self._send(cmd.linear, cmd.angular)
-            speed = cmd.linear
-            if feedback:
-                fb = action.Feedback()
-                fb.current_pose = pose_stamped(*pose, self.global_frame, self.now().to_msg())
-                fb.navigation_time = (self.now() - nav_start).to_msg()
-                dist = rpp._remaining(pose[0], pose[1])
-                fb.distance_remaining = float(dist)
-                fb.estimated_time_remaining = Duration(seconds=dist / max(abs(speed), 1e-3) if speed else 0.0).to_msg()
-                fb.number_of_recoveries = self.recoveries
-                if hasattr(fb, "number_of_poses_remaining"):
-                    fb.number_of_poses_remaining = remaining
-                handle.publish_feedback(fb)
-            await clock.sleep_for(period)
-            t += period
+        return await navigate_with_tree(self, handle, target, action, nav_start, remaining=remaining, feedback=feedback)
 
-    async def _recover(self, handle: Any, why: str) -> None:
-        """Nav2's recoveries in turn: clear + wait, back up, spin; abort when the budget is spent."""
-        if self.recoveries >= self.max_recoveries:
-            raise _Abort(NavigationFailure.UNKNOWN, f"blocked ({why}) and {self.max_recoveries} recoveries did not help")
-        kind = ("clear_and_wait", "backup", "spin")[self.recoveries % 3]
-        self.recoveries += 1
-        self.get_logger().info(f"recovery {self.recoveries}/{self.max_recoveries}: {kind} ({why})")
-        clock = self.get_clock()
-        self._stop_base()
-        if kind == "clear_and_wait" and self.costmap is not None:
-            self.costmap.clear_obstacles()
-            self.costmap.update()
-            await clock.sleep_for(self.wait_duration)
-        elif kind == "backup":
-            for _ in range(int(self.backup_dist / self.backup_speed * self.frequency)):
-                if handle.is_cancel_requested:
-                    break
-                self._send(-self.backup_speed, 0.0)
-                await clock.sleep_for(1.0 / self.frequency)
-        else:
-            speed = self.rpp_params.rotate_to_heading_angular_vel
-            for _ in range(int(self.spin_dist / speed * self.frequency)):
-                if handle.is_cancel_requested:
-                    break
-                self._send(0.0, speed)
-                await clock.sleep_for(1.0 / self.frequency)
-        self._stop_base()
+    def _new_controller(self) -> RegulatedPurePursuit | Mppi:
+        """A fresh instance of the selected controller on the current costmap."""
+        if self.mppi_params is not None:
+            return Mppi(self.mppi_params, self.costmap)
+        return RegulatedPurePursuit(self.rpp_params, self.costmap)
 
-    def _send(self, linear: float, angular: float) -> None:
+    def _send(self, linear: float, angular: float, lateral: float = 0.0) -> None:
         from aiorobot.msgs.geometry_msgs import Twist, Vector3
 
-        self.cmd_pub.publish(Twist(linear=Vector3(x=float(linear)), angular=Vector3(z=float(angular))))
+        self.last_speed = float(math.hypot(linear, lateral))
+        self.cmd_pub.publish(Twist(linear=Vector3(x=float(linear), y=float(lateral)), angular=Vector3(z=float(angular))))
 
     def _stop_base(self) -> None:
         self._send(0.0, 0.0)

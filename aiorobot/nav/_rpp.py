@@ -189,6 +189,10 @@ class RegulatedPurePursuit:
                 return (float(b[0]), float(b[1]))
         return (float(path[-1, 0]), float(path[-1, 1]))
 
+    def remaining(self, x: float, y: float) -> float:
+        """Path length (m) from the robot's nearest path point to the goal, plus the gap to it."""
+        return self._remaining(x, y)
+
     def _remaining(self, x: float, y: float) -> float:
         path = self.path[self._progress :, :2]
         if len(path) == 0:

@@ -84,7 +84,7 @@ def test_a_run_stopped_by_its_duration_exits_0_and_says_so(tmp_path: Path, capsy
                    "--no-perception", "--json", str(tmp_path / "summary.json")])
     out = capsys.readouterr()
     assert status == 0, out.err
-    assert "aiorobot demo — box, direct drive, amcl: stopped after --duration: 1 / 2 waypoints" in out.out
+    assert "aiorobot demo — box, direct drive, amcl, rpp: stopped after --duration: 1 / 2 waypoints" in out.out
     import json
 
     figures = json.loads((tmp_path / "summary.json").read_text())

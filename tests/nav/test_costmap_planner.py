@@ -222,4 +222,4 @@ def test_each_planner_failure_has_its_kind_and_nav2s_named_result_code() -> None
 def test_navigation_failures_carry_nav2s_navigate_to_pose_codes() -> None:
     from aiorobot.nav import NavigationFailure
 
-    assert {k.name: k.code for k in NavigationFailure} == {"UNKNOWN": 9000, "TF_ERROR": 9002}
+    assert {k.name: k.code for k in NavigationFailure} == {"UNKNOWN": 9000, "FAILED_TO_LOAD_BEHAVIOR_TREE": 9001, "TF_ERROR": 9002}
