@@ -30,6 +30,7 @@ from ._landmark_map import (
     save_landmark_map,
 )
 from ._landmarks import LandmarkFixNode, base_pose_from_marker, base_pose_from_markers, map_from_marker
+from ._lifecycle_manager import LifecycleManager, ManagedState
 from ._map_server import MapServer
 from ._mapping import MappingNode, OccupancyMapper
 from ._navigation_server import NavigationFailure, NavigationServer, NavigationStatistics
@@ -49,6 +50,8 @@ __all__ = [
     "base_pose_from_marker",
     "base_pose_from_markers",
     "map_from_marker",
+    "LifecycleManager",
+    "ManagedState",
     "MapServer",
     "MappingNode",
     "OccupancyMapper",
