@@ -21,6 +21,7 @@ import enum
 from typing import Any
 
 from .._core._node import Node
+from ._navigator_lifecycle import LifecycleCommands
 
 __all__ = ["Navigator", "TaskResult"]
 
@@ -34,7 +35,7 @@ class TaskResult(enum.Enum):
     FAILED = 3
 
 
-class Navigator(Node):
+class Navigator(LifecycleCommands, Node):
     """A client of NavigationServer's (or Nav2's) actions with BasicNavigator's methods.
 
     rclpy difference: the methods that wait are coroutines (``await nav.go_to_pose(p)``); the
