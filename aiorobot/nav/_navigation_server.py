@@ -14,7 +14,11 @@ base and ends CANCELED; no ``/map`` within ``map_timeout`` aborts.
 
 A ``geometry_msgs/PoseStamped`` on ``goal_pose`` (the topic RViz's and Foxglove's "2D Goal Pose"
 publish) is sent as a ``navigate_to_pose`` goal to this node's own action server, as Nav2's
-bt_navigator does; a goal refused (one is already running) is logged.
+bt_navigator does; a goal refused (another navigation action is running) is logged.
+
+A new navigate_to_pose (or navigate_through_poses) goal replaces the running one, which ends
+ABORTED, as Nav2's; a goal for another navigation action while one runs is refused (see
+:mod:`._preemption`).
 
 Localisation lost: the pose estimate on ``localization_topic`` (AMCL's ``amcl_pose``, a
 PoseWithCovarianceStamped; ``localization_type = "odometry"`` for an EKF's nav_msgs/Odometry) with a position standard deviation above
@@ -42,6 +46,7 @@ from ._geometry import pose_stamped, transform_to_xyyaw, xyyaw
 from ._map_server import MAP_QOS
 from ._maps import OccupancyMap
 from ._planner import Plan, PlanError, PlanFailure, plan
+from ._preemption import GoalPreemption
 from ._rpp import RegulatedPurePursuit, RppParameters
 
 __all__ = ["NavigationFailure", "NavigationServer", "NavigationStatistics"]
@@ -171,6 +176,7 @@ class NavigationServer(Node):
         self.create_subscription(PoseStamped, "goal_pose", self._on_goal_pose, 10)
         self.last_plan: Plan | None = None
         self.recoveries = 0
+        self._preemption = GoalPreemption(self, (NavigateToPose.Goal, NavigateThroughPoses.Goal))
 
     def statistics(self) -> NavigationStatistics:
         """Recoveries of the current or last goal, whether one is running, the localisation state."""
@@ -237,7 +243,8 @@ class NavigationServer(Node):
     def _accept(self, goal: Any) -> Any:
         from aiorobot import GoalResponse
 
-        return GoalResponse.REJECT if self._busy else GoalResponse.ACCEPT
+        # idle, or a goal of the running navigation action that replaces it (see _preemption.py)
+        return GoalResponse.ACCEPT if not self._busy or self._preemption.preempts(goal) else GoalResponse.REJECT
 
     async def _on_goal_pose(self, pose: Any) -> None:
         """bt_navigator's onGoalPoseReceived: the pose becomes a navigate_to_pose goal of our own server."""
@@ -245,7 +252,7 @@ class NavigationServer(Node):
 
         handle = await self._self_client.send_goal(NavigateToPose.Goal(pose=pose))
         if not handle.accepted:
-            self.get_logger().warning("goal_pose: navigate_to_pose refused the goal (one is already running)")
+            self.get_logger().warning("goal_pose: navigate_to_pose refused the goal (another navigation action is running)")
 
     # -- actions ------------------------------------------------------------------------
 
@@ -266,6 +273,7 @@ class NavigationServer(Node):
             result.error_code = NavigationFailure.UNKNOWN.code
             result.error_msg = "no poses to navigate to: the goal's pose list is empty"
             return result
+        await self._preemption.begin(handle)
         self._busy = True
         self.recoveries = 0
         start = self.now()
@@ -283,6 +291,7 @@ class NavigationServer(Node):
         finally:
             self._stop_base()
             self._busy = False
+            self._preemption.end()
         return result
 
     async def _follow_waypoints(self, handle: Any) -> Any:

@@ -1,0 +1,39 @@
+"""Nav2's preemption on the navigation server: a new navigate_to_pose goal replaces the running one
+(which ends ABORTED), a goal for another navigation action while one runs is refused."""
+
+from __future__ import annotations
+
+import asyncio
+import math
+
+from aiorobot.nav import Navigator, TaskResult, pose_stamped
+
+from .test_navigation_e2e import _until, world  # noqa: F401 - the fixture
+
+
+async def test_a_new_goal_preempts_the_running_one_which_ends_aborted(world) -> None:  # noqa: F811
+    sim, robot, server, nav = world
+    other = server.runtime.add_node(Navigator("second_commander"))
+    assert await nav.go_to_pose(pose_stamped(1.2, -1.0, 0.0))  # around the wall
+    await sim.advance(1.0, step_sec=0.05)
+    assert not nav.is_task_complete() and server.statistics().navigating
+    assert await other.go_to_pose(pose_stamped(-1.2, 0.6, math.pi / 2))  # accepted while the first runs
+    await _until(sim, nav, 5.0)
+    assert nav.get_result() is TaskResult.FAILED  # ABORTED, as Nav2's SimpleActionServer ends it
+    await _until(sim, other, 60.0)
+    assert other.get_result() is TaskResult.SUCCEEDED
+    assert math.hypot(robot.pose[0] + 1.2, robot.pose[1] - 0.6) <= 0.25
+
+
+async def test_another_navigation_action_is_refused_while_one_runs(world) -> None:  # noqa: F811
+    sim, _, server, nav = world
+    other = server.runtime.add_node(Navigator("second_commander"))
+    assert await nav.follow_waypoints([pose_stamped(1.2, -1.0, 0.0)])
+    await sim.advance(0.5, step_sec=0.05)
+    assert not await other.go_to_pose(pose_stamped(-1.2, 0.6, 0.0))
+    assert not await other.go_through_poses([pose_stamped(-1.2, 0.6, 0.0)])
+    assert not nav.is_task_complete()
+    cancel = asyncio.ensure_future(nav.cancel_task())
+    await _until(sim, nav, 5.0)
+    await cancel
+    assert nav.get_result() is TaskResult.CANCELED
