@@ -60,6 +60,10 @@ class LifecycleManager(Node):
 
     ``await manager.startup()`` (and ``pause``, ``resume``, ``reset``, ``shutdown``, ``configure``,
     ``cleanup``) run the same commands as the ``~/manage_nodes`` service and return its success.
+
+    rclpy difference: (Nav2's) liveliness is the graph's, not a bond on ``/bond`` (the managed nodes
+    need no bond code; ``bond_heartbeat_period`` is how often it is checked); a hard reset goes on
+    past a node whose service is gone; no diagnostics are published.
     """
 
     def __init__(self, node_name: str = "lifecycle_manager", namespace: str = "", **kwargs: Any) -> None:

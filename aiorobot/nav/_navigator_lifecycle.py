@@ -4,8 +4,7 @@ As Nav2's: every service of type nav2_msgs/srv/ManageLifecycleNodes in the graph
 manager's ``~/manage_nodes``) is asked to STARTUP (or SHUTDOWN) in turn, waiting for each service and
 for its answer.
 
-rclpy difference: coroutines, and they return whether every manager reported success (BasicNavigator
-returns None and does not look); finding no manager at all is logged, not passed over.
+Where they differ from BasicNavigator's: see :meth:`LifecycleCommands.lifecycle_startup`.
 """
 
 from __future__ import annotations
@@ -29,6 +28,10 @@ class LifecycleCommands:
         """STARTUP every lifecycle manager (configure then activate its nodes); True if all succeeded.
 
         ``timeout_sec`` bounds each manager's answer (None: wait, as BasicNavigator does).
+
+        rclpy difference: a coroutine returning whether every manager succeeded (BasicNavigator's
+        returns None); no manager in the graph is logged and returns False; the initial pose is not
+        re-sent while a manager starts up (aiorobot's AMCL is not a lifecycle node to wait for).
         """
         from aiorobot.msgs.nav2_msgs import ManageLifecycleNodes
 
