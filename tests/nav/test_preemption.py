@@ -37,3 +37,13 @@ async def test_another_navigation_action_is_refused_while_one_runs(world) -> Non
     await _until(sim, nav, 5.0)
     await cancel
     assert nav.get_result() is TaskResult.CANCELED
+
+
+async def test_the_navigator_sends_a_new_goal_over_its_running_one_as_basic_navigator(world) -> None:  # noqa: F811
+    sim, robot, _, nav = world
+    assert await nav.go_to_pose(pose_stamped(1.2, -1.0, 0.0))
+    await sim.advance(1.0, step_sec=0.05)
+    assert await nav.go_to_pose(pose_stamped(-1.2, 0.6, math.pi / 2))  # the server preempts the first
+    await _until(sim, nav, 60.0)
+    assert nav.get_result() is TaskResult.SUCCEEDED  # the second goal's, not the aborted first's
+    assert math.hypot(robot.pose[0] + 1.2, robot.pose[1] - 0.6) <= 0.25
