@@ -1,8 +1,8 @@
 """The import aliases: ``rclpy``, message packages, ``tf2_ros``, ``message_filters`` -> aiorobot.
 
 A meta path finder placed first on ``sys.meta_path``: ``rclpy[.x]`` resolves to
-``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters``/``cv_bridge`` to
-their aiorobot modules, and ``<pkg>.msg|srv|action`` to module views of
+``aiorobot.compat.rclpy[.x]``, ``tf2_ros``/``tf2_geometry_msgs``/``message_filters``/``cv_bridge``/
+``nav2_simple_commander`` to their aiorobot modules, and ``<pkg>.msg|srv|action`` to module views of
 ``aiorobot.msgs`` for every package aiorobot has interfaces of.
 """
 
@@ -27,6 +27,7 @@ _ALIASES = {
     "message_filters": "aiorobot.message_filters",
     "sensor_msgs_py": "aiorobot.compat.sensor_msgs_py",
     "cv_bridge": "aiorobot.compat.cv_bridge",
+    "nav2_simple_commander": "aiorobot.compat.nav2_simple_commander",
 }
 #: rclpy modules aiorobot lacks: importing one names it.
 _MISSING_MODULES = frozenset(
