@@ -16,9 +16,9 @@ A ``geometry_msgs/PoseStamped`` on ``goal_pose`` (the topic RViz's and Foxglove'
 publish) is sent as a ``navigate_to_pose`` goal to this node's own action server, as Nav2's
 bt_navigator does; a goal refused (another navigation action is running) is logged.
 
-A new navigate_to_pose (or navigate_through_poses) goal replaces the running one, which ends
-ABORTED, as Nav2's; a goal for another navigation action while one runs is refused (see
-:mod:`._preemption`).
+A new navigate_to_pose (navigate_through_poses, follow_waypoints) goal replaces the running one
+of its action, which ends ABORTED, as Nav2's; a goal for another navigation action while one runs
+is refused (see :mod:`._preemption`).
 
 Localisation lost: the pose estimate on ``localization_topic`` (AMCL's ``amcl_pose``, a
 PoseWithCovarianceStamped; ``localization_type = "odometry"`` for an EKF's nav_msgs/Odometry) with a position standard deviation above
@@ -176,7 +176,7 @@ class NavigationServer(Node):
         self.create_subscription(PoseStamped, "goal_pose", self._on_goal_pose, 10)
         self.last_plan: Plan | None = None
         self.recoveries = 0
-        self._preemption = GoalPreemption(self, (NavigateToPose.Goal, NavigateThroughPoses.Goal))
+        self._preemption = GoalPreemption(self, (NavigateToPose.Goal, NavigateThroughPoses.Goal, FollowWaypoints.Goal))
 
     def statistics(self) -> NavigationStatistics:
         """Recoveries of the current or last goal, whether one is running, the localisation state."""
@@ -302,6 +302,7 @@ class NavigationServer(Node):
         if not poses:
             handle.abort()
             return result
+        await self._preemption.begin(handle)
         self._busy = True
         self.recoveries = 0
         start = self.now()
@@ -328,6 +329,7 @@ class NavigationServer(Node):
         finally:
             self._stop_base()
             self._busy = False
+            self._preemption.end()
         return result
 
     async def _compute_path(self, handle: Any) -> Any:

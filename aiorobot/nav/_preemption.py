@@ -1,8 +1,9 @@
-"""Goal preemption for the navigation server's navigate_to_pose and navigate_through_poses, as Nav2's.
+"""Goal preemption for the navigation server's navigate_to_pose, navigate_through_poses and
+follow_waypoints, as Nav2's.
 
-Nav2's bt_navigator serves each with nav2_util's SimpleActionServer: a new goal for the action that
-is running is accepted and replaces the running one, which ends ABORTED with an empty result
-(``accept_pending_goal``); a goal for another navigation action while one runs is refused, as is
+Nav2's bt_navigator and waypoint_follower serve each with nav2_util's SimpleActionServer: a new
+goal for the action that is running is accepted and replaces the running one, which ends ABORTED
+with an empty result (``accept_pending_goal``); a goal for another navigation action while one runs is refused, as is
 (here) a new goal asking for another behaviour tree than the running goal's.
 
 :meth:`GoalPreemption.begin`, called by a goal's execute before it drives, cancels the task of every

@@ -1,5 +1,6 @@
-"""Nav2's preemption on the navigation server: a new navigate_to_pose goal replaces the running one
-(which ends ABORTED), a goal for another navigation action while one runs is refused."""
+"""Nav2's preemption on the navigation server: a new goal of the running action (navigate_to_pose,
+navigate_through_poses, follow_waypoints) replaces the running one, which ends ABORTED; a goal for
+another navigation action while one runs is refused."""
 
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ async def test_a_new_goal_preempts_the_running_one_which_ends_aborted(world) -> 
     assert math.hypot(robot.pose[0] + 1.2, robot.pose[1] - 0.6) <= 0.25
 
 
-async def test_another_navigation_action_is_refused_while_one_runs(world) -> None:  # noqa: F811
+async def test_another_navigation_action_is_refused_while_one_runs_and_the_same_one_preempts(world) -> None:  # noqa: F811
     sim, _, server, nav = world
     other = server.runtime.add_node(Navigator("second_commander"))
     assert await nav.follow_waypoints([pose_stamped(1.2, -1.0, 0.0)])
@@ -33,6 +34,10 @@ async def test_another_navigation_action_is_refused_while_one_runs(world) -> Non
     assert not await other.go_to_pose(pose_stamped(-1.2, 0.6, 0.0))
     assert not await other.go_through_poses([pose_stamped(-1.2, 0.6, 0.0)])
     assert not nav.is_task_complete()
+    assert await other.follow_waypoints([pose_stamped(-1.2, 0.6, 0.0)])  # the same action: preempts
+    await _until(sim, nav, 5.0)
+    assert nav.get_result() is TaskResult.FAILED
+    nav, other = other, nav
     cancel = asyncio.ensure_future(nav.cancel_task())
     await _until(sim, nav, 5.0)
     await cancel
