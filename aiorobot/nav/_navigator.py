@@ -133,25 +133,27 @@ class Navigator(Node):
                                                                    progress_checker_id=progress_checker_id))
 
     async def _send(self, client: Any, goal: Any, timeout_sec: float = 10.0) -> bool:
-        if self._result_task is not None and not self._result_task.done():
-            raise RuntimeError("a navigation task is already running; cancel_task() or wait for it first")
+        # A goal sent while a task runs becomes the task, as in BasicNavigator: the server preempts
+        # the running goal (navigate_to_pose: it ends aborted) or refuses the new one.
         if not await client.wait_for_server(timeout_sec=timeout_sec):
             self.get_logger().error(f"{client!r}: no action server within {timeout_sec:g} s")
             return False
-        self.result = self.status = self._feedback = None
-        self._handle = await client.send_goal(goal, feedback_callback=self._on_feedback)
-        if not self._handle.accepted:
+        handle = await client.send_goal(goal, feedback_callback=self._on_feedback)
+        if not handle.accepted:
             self.get_logger().error("goal rejected")
             return False
-        self._result_task = self.create_task(self._wait_result())
+        self.result = self.status = self._feedback = None
+        self._handle = handle
+        self._result_task = self.create_task(self._wait_result(handle))
         return True
 
     def _on_feedback(self, msg: Any) -> None:
         self._feedback = getattr(msg, "feedback", msg)
 
-    async def _wait_result(self) -> None:
-        self.result = await self._handle.result()
-        self.status = self._handle.status
+    async def _wait_result(self, handle: Any) -> None:
+        result = await handle.result()
+        if handle is self._handle:  # not a goal a newer one replaced
+            self.result, self.status = result, handle.status
 
     def is_task_complete(self) -> bool:
         """True when the last task ended (or none was sent)."""

@@ -1,7 +1,5 @@
-"""``nav2_simple_commander`` for rclpy programs on aiorobot: :mod:`.robot_navigator`'s BasicNavigator."""
+"""``nav2_simple_commander`` on aiorobot: ``robot_navigator.BasicNavigator`` for programs run by ``aiorobot exec``."""
 
 from __future__ import annotations
 
-from .robot_navigator import BasicNavigator, RunningTask, TaskResult
-
-__all__ = ["BasicNavigator", "RunningTask", "TaskResult"]
+__all__: list[str] = []
