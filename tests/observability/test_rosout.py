@@ -26,6 +26,9 @@ async def main(rt):
     while True:
         n += 1
         node.get_logger().info(f"tick {n}")
+        if n % 20 == 0:  # again each second: /rosout's 10 s lifespan ends the first pair's history on a slow machine
+            other.get_logger().warning("exposure clipped")
+            node.get_logger().error("motor 2 over current")
         await asyncio.sleep(0.05)
 """
 
