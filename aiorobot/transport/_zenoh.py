@@ -29,7 +29,7 @@ import logging
 import os
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -39,6 +39,9 @@ from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, Reliabilit
 from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
 from .._core._transport import Transport
+from ..msgs import DeserializationError as _DeserializationError
+from ..msgs import deserialize as _deserialize
+from ..msgs import serialize as _serialize
 from ._diagnose import NOTHING_LISTENS, host_port, why_unreachable
 from ._session_config import (
     SessionPlan,
@@ -52,6 +55,9 @@ from ._session_config import (
 )
 from ._wire import (
     WireError,
+    attachment_gid,
+    attachment_head,
+    attachment_tail,
     data_key,
     dds_type,
     endpoint_token,
@@ -87,6 +93,11 @@ SHM_MIN_CHECK = 1024  # smaller payloads are never in shared memory here: skip a
 DEFAULT_SOURCE = "the default session config"
 #: the "no zenoh router" warning is given once a process
 _router_warned = threading.Event()
+#: received samples a topic holds for the main loop at most (a loop that stalled for longer than this
+#: many messages loses the oldest, counted as ``backlog`` drops); KEEP_LAST subscriptions keep their depth
+BACKLOG_LIMIT = 10_000
+#: messages the main loop injects before it lets the subscriptions' dispatchers run (bounded by their depth)
+MAX_CHUNK = 64
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
 
@@ -216,7 +227,12 @@ class _LocalNode:
 
 
 class _Outbound:
-    """One topic's zenoh publisher, fed by a hidden tap on the bus."""
+    """One topic's zenoh publisher, fed by a hidden tap on the bus.
+
+    Everything a put needs that does not change per message (key, attachment tail with the
+    GID, QoS, the shared-memory threshold) is settled here once; :meth:`_send` only
+    serialises, stamps and puts.
+    """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
         self.transport = transport
@@ -224,14 +240,17 @@ class _Outbound:
         self.msg_type = msg_type
         self.key = data_key(transport.domain_id, topic, msg_type.__msgtype__, type_hash)
         self.publishers: list[Publisher[Any]] = []
-        self.gid = b"\0" * 16
-        self.seq = 0
+        self._tail = attachment_tail(b"\0" * 16)
+        self._seq = itertools.count(1)
         self.zpub: Any = None
         self.advanced = False
         self.depth = 0
-        self.lock = threading.Lock()
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>")
         self.tap.hidden = True  # type: ignore[attr-defined]
+
+    def set_gid(self, gid: bytes) -> None:
+        """The GID every put's attachment carries (that of the topic's first local publisher)."""
+        self._tail = attachment_tail(gid)
 
     def declare(self, qos: QoSProfile) -> None:
         """(Re)declare the zenoh publisher so it serves ``qos`` (a cache for transient local)."""
@@ -278,20 +297,17 @@ class _Outbound:
         transport = self.transport
         if getattr(transport._local, "injecting", False):
             return  # it came from the network: do not echo it back
-        from ..msgs import serialize
-
         try:
-            data = serialize(msg)
+            data = _serialize(msg)
         except (TypeError, ValueError) as err:
             transport._warn("serialize", f"cannot send a message on {self.topic}: {err}")
             return
-        with self.lock:
-            self.seq += 1
-            attachment = pack_attachment(self.seq, time.time_ns(), self.gid)
-            zpub = self.zpub
-        if zpub is not None:
-            zpub.put(transport._payload(data), attachment=attachment)
-            transport._sent += 1
+        zpub = self.zpub
+        if zpub is None:
+            return
+        attachment = attachment_head(next(self._seq), time.time_ns()) + self._tail
+        zpub.put(data if len(data) < transport._shm_from else transport._payload(data), attachment=attachment)
+        transport._sent += 1
 
     def close(self) -> None:
         if self.zpub is not None:
@@ -300,7 +316,14 @@ class _Outbound:
 
 
 class _Inbound:
-    """One topic's zenoh subscriber; hands checked, decoded messages to the bus."""
+    """One topic's zenoh subscriber; hands checked, decoded messages to the bus.
+
+    zenoh's thread only queues a sample and, when none was waiting, wakes the main loop
+    (one ``call_soon_threadsafe`` per batch of samples that arrive together). The loop
+    checks, decodes and injects them, at most as many per turn as the smallest depth of
+    the topic's subscriptions before their dispatchers run: a burst that piled up while
+    the process was descheduled fills no subscription queue past its depth.
+    """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
         self.transport = transport
@@ -308,11 +331,30 @@ class _Inbound:
         self.msg_type = msg_type
         self.type_hash = type_hash
         self.prefix = f"{transport.domain_id}/{topic.strip('/')}/{dds_type(msg_type.__msgtype__)}"
+        self.key = f"{self.prefix}/{type_hash}"
         self.subscriptions: list[Subscription[Any]] = []
         self.zsub: Any = None
         self.advanced = False
         self.depth = 0
+        self.chunk = MAX_CHUNK
         self.fallback = _Injector(transport._owner, msg_type, topic, _FALLBACK_QOS, "<zenoh>", hidden=True)
+        self._pending: deque[Any] = deque()
+        self._armed = False  # a drain is due on the loop
+        self._arming = threading.Lock()
+        self._injector: _Injector | None = None  # the injector of the last sample's GID
+        self._gid = b""
+
+    def add(self, sub: Any) -> None:
+        self.subscriptions.append(sub)
+        self._rechunk()
+
+    def remove(self, sub: Any) -> None:
+        self.subscriptions.remove(sub)
+        self._rechunk()
+
+    def _rechunk(self) -> None:
+        depths = [s.qos.depth for s in self.subscriptions if s.qos.history is HistoryPolicy.KEEP_LAST]
+        self.chunk = max(1, min([MAX_CHUNK, *depths]))
 
     def declare(self, qos: QoSProfile) -> None:
         import zenoh
@@ -344,40 +386,97 @@ class _Inbound:
             old.undeclare()
 
     def _on_sample(self, sample: Any) -> None:
-        """On a zenoh thread: check and decode, then hand over to the main loop."""
-        transport = self.transport
-        from ..msgs import DeserializationError, deserialize
+        """On a zenoh thread: queue the sample; wake the loop unless a drain is already due."""
+        pending = self._pending
+        if len(pending) >= BACKLOG_LIMIT:
+            pending.popleft()
+            self.transport._warn(
+                "backlog", f"dropped the oldest sample on {self.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
+            )
+        pending.append(sample)
+        if not self._armed:
+            with self._arming:
+                if self._armed:
+                    return
+                self._armed = True
+            self.transport._to_loop(self._drain)
 
+    def _drain(self) -> None:
+        """On the main loop: decode and inject up to ``chunk`` queued samples, then let the
+        dispatchers run before the next chunk (one drain is due at a time)."""
+        pending = self._pending
+        transport = self.transport
+        local = transport._local
+        local.injecting = True
+        try:
+            for _ in range(self.chunk):
+                if not pending:
+                    break
+                decoded = self._decode(pending.popleft())
+                if decoded is not None:
+                    self._inject(*decoded)
+        finally:
+            local.injecting = False
+        loop = transport._loop
+        if not pending or loop is None or loop.is_closed():
+            with self._arming:
+                self._armed = False
+                if not pending or loop is None or loop.is_closed():
+                    return
+                self._armed = True  # a sample came in between: it would wait for the next one
+        loop.call_soon(self._drain)
+
+    def _decode(self, sample: Any) -> tuple[bytes, Any] | None:
+        """Check a sample (key, attachment, CDR) and decode it: ``(gid, message)``, or None when dropped."""
+        transport = self.transport
         key = str(sample.key_expr)
         try:
-            found_hash = key[len(self.prefix) + 1 :]
-            if found_hash != self.type_hash:
+            if key != self.key:
+                found_hash = key[len(self.prefix) + 1 :]
                 raise WireError(
                     f"type hash on {self.topic}: expected {self.type_hash} for {self.msg_type.__msgtype__}, "
                     f"found {found_hash or 'none'}; the two sides use different definitions"
                 )
             raw = sample.attachment
-            attachment = unpack_attachment(None if raw is None else raw.to_bytes())
+            gid = attachment_gid(None if raw is None else raw.to_bytes())
             payload = sample.payload
-            msg = deserialize(payload.to_bytes(), self.msg_type)
-            if len(payload) >= SHM_MIN_CHECK and payload.as_shm() is not None:
+            data = payload.to_bytes()
+            msg = _deserialize(data, self.msg_type)
+            if len(data) >= SHM_MIN_CHECK and payload.as_shm() is not None:
                 transport._received_shm += 1
         except WireError as err:
             transport._warn("wire", f"dropped a sample on {key}: {err}")
-            return
-        except DeserializationError as err:
+            return None
+        except _DeserializationError as err:
             transport._warn("cdr", f"dropped a sample on {key}: malformed CDR: {err}")
-            return
+            return None
         except Exception as err:  # noqa: BLE001 - nothing from the network may escape
             transport._warn("other", f"dropped a sample on {key}: {type(err).__name__}: {err}")
-            return
+            return None
         transport._received += 1
-        transport._to_loop(transport._inject, self, attachment.gid, msg)
+        return gid, msg
+
+    def _inject(self, gid: bytes, msg: Any) -> None:
+        """On the main loop: publish a received message into the bus as its remote publisher."""
+        injector = self._injector
+        if gid != self._gid or injector is None or injector.destroyed:
+            injector = self.transport._by_gid.get(gid)
+            if injector is None or injector.topic_name != self.topic or injector.msg_type is not self.msg_type:
+                injector = self.fallback  # not remembered: the publisher's own injector may arrive later
+            else:
+                self._gid, self._injector = gid, injector
+        if injector.destroyed:
+            return
+        try:
+            injector.publish(msg)
+        except Exception as err:  # noqa: BLE001
+            self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
 
     def close(self) -> None:
         if self.zsub is not None:
             self.zsub.undeclare()
             self.zsub = None
+        self._pending.clear()
 
 
 class ZenohTransport(Transport):
@@ -454,8 +553,8 @@ class ZenohTransport(Transport):
         self._last_warning: dict[str, float] = {}
         self._hashes: dict[Any, str] = {}
         self._shm: Any = None  # zenoh.shm.ShmProvider when the session has shared memory enabled
-        #: messages of this many bytes or more (CDR) go through shared memory, when it is enabled
-        self.shm_threshold = SHM_THRESHOLD
+        self._shm_threshold = SHM_THRESHOLD
+        self._shm_from = float("inf")  # the threshold while a pool is open, else never
         self._sent_shm = 0
         self._received_shm = 0
         self._drops_shm_full = 0  # sends that fell back to the network because the pool was full
@@ -586,8 +685,20 @@ class ZenohTransport(Transport):
             from zenoh.shm import ShmProvider
 
             self._shm = ShmProvider.default_backend(size)
+            self._shm_from = self._shm_threshold
         except Exception as err:  # noqa: BLE001 - no /dev/shm, a platform without it: use the network
             _log.warning(f"zenoh shared memory is enabled but a {size}-byte pool could not be made ({err}); large messages go over the network")
+
+    @property
+    def shm_threshold(self) -> int:
+        """Messages of this many bytes or more (CDR) go through shared memory, when it is enabled."""
+        return self._shm_threshold
+
+    @shm_threshold.setter
+    def shm_threshold(self, value: int) -> None:
+        self._shm_threshold = value
+        if self._shm is not None:
+            self._shm_from = value
 
     def _payload(self, data: bytes) -> Any:
         """``data`` as zenoh should send it: in a shared-memory buffer when it is large enough."""
@@ -700,7 +811,7 @@ class ZenohTransport(Transport):
             elif isinstance(endpoint, (Subscription, Tap)):
                 inb = self._inbound.get((endpoint.topic_name, endpoint.type_name))
                 if inb is not None and endpoint in inb.subscriptions:
-                    inb.subscriptions.remove(endpoint)
+                    inb.remove(endpoint)
                     if not inb.subscriptions:
                         del self._inbound[(inb.topic, endpoint.type_name)]
                         if self.bus is not None:
@@ -719,7 +830,7 @@ class ZenohTransport(Transport):
         new = out is None
         if out is None:
             out = self._outbound[key] = _Outbound(self, pub.topic_name, pub.msg_type, type_hash)
-            out.gid = gid_of(token)
+            out.set_gid(gid_of(token))
         out.declare(pub.qos)
         out.publishers.append(pub)
         if new and self.bus is not None:
@@ -732,7 +843,7 @@ class ZenohTransport(Transport):
         new = inb is None
         if inb is None:
             inb = self._inbound[key] = _Inbound(self, sub.topic_name, sub.msg_type, type_hash)
-        inb.subscriptions.append(sub)
+        inb.add(sub)
         if new and self.bus is not None:
             self.bus.add_publisher(inb.fallback)
         inb.declare(sub.qos)
@@ -740,21 +851,6 @@ class ZenohTransport(Transport):
         # token, and so counts the subscription as matched, finds the route to it already declared.
         if sub.node is not None:  # the runtime's /clock tap has no node: it receives without a graph entry
             self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
-
-    def _inject(self, inbound: _Inbound, gid: bytes, msg: Any) -> None:
-        """On the main loop: publish a received message into the bus as its remote publisher."""
-        injector = self._by_gid.get(gid)
-        if injector is None or injector.topic_name != inbound.topic or injector.msg_type is not inbound.msg_type:
-            injector = inbound.fallback
-        if injector.destroyed:
-            return
-        self._local.injecting = True
-        try:
-            injector.publish(msg)
-        except Exception as err:  # noqa: BLE001
-            self._warn("inject", f"could not deliver a message on {inbound.topic}: {err}")
-        finally:
-            self._local.injecting = False
 
     # -- services --------------------------------------------------------------------------
 
