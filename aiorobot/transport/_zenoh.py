@@ -490,7 +490,7 @@ class ZenohTransport(Transport):
         A zenoh JSON5 config file used as is (routers, TLS/mTLS, access control).
         Without one: peer mode, listen on ``tcp/127.0.0.1:0``, connect to a router
         on ``tcp/127.0.0.1:7447``, multicast scouting off (rmw_zenoh's defaults, on
-        loopback), and zenoh's transmit batching off (latency before throughput). ``ZENOH_SESSION_CONFIG_URI`` names a file too, and
+        loopback). ``ZENOH_SESSION_CONFIG_URI`` names a file too, and
         ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``) applies last, as in rmw_zenoh.
     connect, listen
         Endpoints replacing the defaults.
@@ -1182,10 +1182,9 @@ def build_session_config(
         cfg.insert_json5("scouting/multicast/enabled", "false")
         cfg.insert_json5("listen/endpoints", json.dumps(listen or [DEFAULT_LISTEN]))
         cfg.insert_json5("connect/endpoints", json.dumps(connect if connect is not None else [DEFAULT_CONNECT]))
-        # zenoh's lazy batching holds a small message up to batching/time_limit (1 ms) and, at a
-        # steady 1-2 kHz, for several: 3-5 ms one-way on loopback instead of ~0.2 ms. A robot's
-        # graph wants latency; a config file (or ZENOH_CONFIG_OVERRIDE) can turn it back on.
-        cfg.insert_json5("transport/link/tx/queue/batching/enabled", "false")
+        # zenoh's transmit batching stays on (its default and rmw_zenoh's): it batches only under
+        # back-pressure, so a steady stream is not held back, and a stall of the transmit thread
+        # fills a batch instead of two one-message slots that then drop (docs/zenoh.md)
         # Large messages (images, clouds) to peers on this host go through shared memory;
         # zenoh falls back to the network for a peer that cannot map it.
         cfg.insert_json5("transport/shared_memory/enabled", "true")
