@@ -267,11 +267,15 @@ def _sender_commands(small: Any, picture: Any) -> Any:
                 small(1)
             return json.dumps({"sent": n, "send_sec": time.perf_counter() - start})
         period = 1.0 / (SMALL_HZ if verb == "small" else IMAGE_HZ)
+        send = (lambda: small(0)) if verb == "small" else picture
+        cost: list[int] = []  # how long the publish call itself takes (perf_counter_ns)
         for i in range(n):
-            small(0) if verb == "small" else picture()
+            t0 = time.perf_counter_ns()
+            send()
+            cost.append(time.perf_counter_ns() - t0)
             delay = start + (i + 1) * period - time.perf_counter()
             await asyncio.sleep(max(delay, 0.0))
-        return json.dumps({"sent": n, "send_sec": time.perf_counter() - start})
+        return json.dumps({"sent": n, "send_sec": time.perf_counter() - start, "cost": cost})
 
     return handle
 
@@ -369,7 +373,8 @@ def run(quick: bool = False) -> dict[str, Any]:
     router = zenoh.open(cfg)
     pairs: dict[str, tuple[_Peer, _Peer]] = {}
     pooled: dict[str, dict[str, Any]] = {
-        p: {"small": [], "image": [], "burst": [], "small_sent": 0, "image_sent": 0} for p in paths
+        p: {"small": [], "image": [], "burst": [], "small_sent": 0, "image_sent": 0, "small_cost": [], "image_cost": []}
+        for p in paths
     }
     errors: dict[str, str] = {}
     try:
@@ -410,8 +415,8 @@ def run(quick: bool = False) -> dict[str, Any]:
         got = pooled[path]
         rates = [b["received"] / max((b["last"] - b["first"]) / 1e9, 1e-9) for b in got["burst"] if b["received"] > 1]
         rows[path] = {
-            "small": {**_stats(got["small"]), "sent": got["small_sent"]},
-            "image": {**_stats(got["image"]), "sent": got["image_sent"]},
+            "small": {**_stats(got["small"]), "sent": got["small_sent"], "send_call": _stats(got["small_cost"])},
+            "image": {**_stats(got["image"]), "sent": got["image_sent"], "send_call": _stats(got["image_cost"])},
             "burst": {
                 "sent": sum(b["sent"] for b in got["burst"]),
                 "received": sum(b["received"] for b in got["burst"]),
@@ -435,11 +440,15 @@ def _warm_up(recv: _Peer, send: _Peer) -> None:
 
 
 def _round(recv: _Peer, send: _Peer, into: dict[str, Any], n_small: int, n_image: int, n_burst: int) -> None:
-    sent = send.ask(f"small {n_small}")["sent"]
+    reply = send.ask(f"small {n_small}")
+    sent = reply["sent"]
     into["small_sent"] += sent
+    into["small_cost"] += reply["cost"]
     into["small"] += _collect(recv, sent, "small")["small"]
-    sent = send.ask(f"image {n_image}")["sent"]
+    reply = send.ask(f"image {n_image}")
+    sent = reply["sent"]
     into["image_sent"] += sent
+    into["image_cost"] += reply["cost"]
     into["image"] += _collect(recv, sent, "image")["image"]
     sent = send.ask(f"burst {n_burst}")["sent"]
     burst = _collect(recv, sent, "burst")["burst"]
@@ -483,7 +492,7 @@ def table(part: dict[str, Any]) -> Any:
     }
     for path, fig in part.get("paths", {}).items():
         if "error" in fig:
-            rows.append((names.get(path, path), fig["error"], "", "", "", ""))
+            rows.append((names.get(path, path), fig["error"], "", "", "", "", "", ""))
             continue
         s, i, b = fig["small"], fig["image"], fig["burst"]
         rates = b["recv_msgs_per_sec"]
@@ -491,12 +500,14 @@ def table(part: dict[str, Any]) -> Any:
         rows.append((
             names.get(path, path), s.get("p50_us", nan), s.get("p99_us", nan), i.get("p50_us", nan), i.get("p99_us", nan),
             f"{rate} ({100 * b['received'] / max(b['sent'], 1):.0f} % of {b['sent']})",
+            s.get("send_call", {}).get("p50_us", nan), i.get("send_call", {}).get("p50_us", nan),
         ))
     for path, why in part.get("skipped", {}).items():
-        rows.append((path, f"not measured: {why}", "", "", "", ""))
+        rows.append((path, f"not measured: {why}", "", "", "", "", "", ""))
     return figure_table(
         title,
-        ("path", "small p50 us", "small p99 us", "image p50 us", "image p99 us", "burst received msgs/s"),
+        ("path", "small p50 us", "small p99 us", "image p50 us", "image p99 us", "burst received msgs/s",
+         "send call p50 us (small)", "send call p50 us (image)"),
         rows,
         caption=f"small: {SMALL_BYTES} bytes at {SMALL_HZ:.0f} Hz; image: 640x480x3 at {IMAGE_HZ:.0f} Hz; "
         f"pooled over {part.get('rounds', '?')} rounds",
