@@ -362,7 +362,7 @@ def run(quick: bool = False) -> dict[str, Any]:
 
     from ._noise import NoiseMeter
 
-    rounds, n_small, n_image, n_burst = (2, 200, 15, 2000) if quick else (3, 2000, 100, 20000)
+    rounds, n_small, n_image, n_burst = (1, 200, 10, 2000) if quick else (3, 2000, 100, 20000)
     reasons = available_paths()
     paths = [p for p, why in reasons.items() if why is None]
     port = _free_port()
@@ -455,7 +455,7 @@ def _round(recv: _Peer, send: _Peer, into: dict[str, Any], n_small: int, n_image
     into["burst"].append({"sent": sent, "received": burst["n"], "first": burst["first"], "last": burst["last"]})
 
 
-def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.3) -> dict[str, Any]:
+def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.2) -> dict[str, Any]:
     """The receiver's reports merged until ``expected`` messages of ``kind`` arrived or none came for
     ``quiet_sec`` (what did not arrive by then was lost)."""
     got: dict[str, Any] = {"small": [], "image": [], "burst": {"n": 0, "first": 0, "last": 0}}
