@@ -441,7 +441,7 @@ class _Inbound:
             gid = attachment_gid(None if raw is None else raw.to_bytes())
             payload = sample.payload
             data = payload.to_bytes()
-            msg = _deserialize(data, self.msg_type)
+            msg = _deserialize(data, self.msg_type, view=True)  # arrays: read-only views into the bytes
             if len(data) >= SHM_MIN_CHECK and payload.as_shm() is not None:
                 transport._received_shm += 1
         except WireError as err:
