@@ -263,8 +263,10 @@ def _sender_commands(small: Any, picture: Any) -> Any:
         n = int(count)
         start = time.perf_counter()
         if verb == "burst":
-            for _ in range(n):
+            for i in range(n):
                 small(1)
+                if i % 500 == 499:
+                    await asyncio.sleep(0)  # a long burst must not read as a stalled loop
             return json.dumps({"sent": n, "send_sec": time.perf_counter() - start})
         period = 1.0 / (SMALL_HZ if verb == "small" else IMAGE_HZ)
         send = (lambda: small(0)) if verb == "small" else picture
