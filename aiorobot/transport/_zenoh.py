@@ -244,6 +244,7 @@ class _Outbound:
         self._seq = itertools.count(1)
         self.zpub: Any = None
         self.advanced = False
+        self.matched = False  # a remote subscriber matches the key (kept by zenoh's matching listener)
         self.depth = 0
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>")
         self.tap.hidden = True  # type: ignore[attr-defined]
@@ -275,6 +276,7 @@ class _Outbound:
         old = self.zpub
         if want_cache or self.advanced:
             self.depth = max(depth, self.depth)
+            self.matched = True
             self.zpub = zenoh.ext.declare_advanced_publisher(
                 session,
                 self.key,
@@ -288,22 +290,31 @@ class _Outbound:
             self.advanced = True
         else:
             self.depth = max(depth, self.depth)
-            self.zpub = session.declare_publisher(self.key, **kwargs)
+            zpub = session.declare_publisher(self.key, **kwargs)
+            # no remote subscriber matches: nothing to serialise (zenoh would drop the put); an
+            # advanced publisher's cache needs every message, so it has no listener
+            zpub.declare_matching_listener(self._on_matching)
+            self.matched = zpub.matching_status.matching
+            self.zpub = zpub
         if old is not None:
             old.undeclare()
+
+    def _on_matching(self, status: Any) -> None:
+        if not self.advanced:
+            self.matched = status.matching
 
     def _send(self, msg: Any) -> None:
         """The tap's callback: runs in the publishing thread."""
         transport = self.transport
-        if getattr(transport._local, "injecting", False):
-            return  # it came from the network: do not echo it back
+        zpub = self.zpub
+        if zpub is None or getattr(transport._local, "injecting", False):
+            return  # closed, or it came from the network: do not echo it back
+        if not self.matched and not zpub.matching_status.matching:
+            return  # no remote subscriber (asked, as the listener's word may still be on its way)
         try:
             data = _serialize(msg)
         except (TypeError, ValueError) as err:
             transport._warn("serialize", f"cannot send a message on {self.topic}: {err}")
-            return
-        zpub = self.zpub
-        if zpub is None:
             return
         attachment = attachment_head(next(self._seq), time.time_ns()) + self._tail
         zpub.put(data if len(data) < transport._shm_from else transport._payload(data), attachment=attachment)
