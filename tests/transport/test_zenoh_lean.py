@@ -131,3 +131,58 @@ async def test_a_received_image_is_a_read_only_view_into_the_payload(router_port
             assert isinstance(_root(data), bytes)  # the payload's bytes, decoded in place
     finally:
         await child.stop()
+
+
+BURSTER = """
+from aiorobot.msgs.geometry_msgs import Twist, Vector3
+async def main(rt):
+    node = Node("burster")
+    rt.add_node(node)
+    pub = node.create_publisher(Twist, "/burst", QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+    say("ready")
+    reader = await stdin_lines()
+    while (line := (await reader.readline()).decode().strip()) == "ping":
+        pub.publish(Twist(linear=Vector3(x=-1.0)))
+        say("pinged")
+    for i in range(int(line)):
+        pub.publish(Twist(linear=Vector3(x=float(i))))
+        if i % 50 == 49:
+            await asyncio.sleep(0)
+    say("done")
+    await reader.readline()
+"""
+
+
+async def test_a_loop_stalled_past_the_backlog_limit_loses_the_oldest_and_says_so(
+    router_port: int, monkeypatch: Any, caplog: Any
+) -> None:
+    import time
+
+    from aiorobot.transport import _zenoh
+
+    monkeypatch.setattr(_zenoh, "BACKLOG_LIMIT", 50)
+    child = await spawn(BURSTER, router_port)
+    try:
+        await child.expect("ready")
+        async with _runtime(router_port) as rt:
+            node = rt.add_node(Node("slow"))
+            got: list[int] = []
+            node.create_subscription(Twist, "/burst", lambda m: got.append(int(m.linear.x)), QoSProfile(depth=100))
+            await _first_arrival(child, rt, "/burst", got)
+            child.send("300")
+            assert child.proc.stdin is not None
+            await child.proc.stdin.drain()
+            # the main loop stalls (a blocking call) while zenoh's thread keeps receiving the burst
+            deadline = time.monotonic() + 20
+            while rt.transport.statistics().drop_reasons.get("backlog", 0) == 0 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            backlog = rt.transport.statistics().drop_reasons.get("backlog", 0)
+            assert backlog > 0
+            await child.expect("done")
+            await wait_until(lambda: bool(got) and got[-1] == 299)
+            stream = [x for x in got if x >= 0]
+            assert stream == sorted(stream) and len(stream) <= 300 - backlog  # the oldest went, in order
+            assert any("50 were waiting for the main loop" in r.getMessage() for r in caplog.records)
+            child.send("bye")
+    finally:
+        await child.stop()
