@@ -93,11 +93,13 @@ SHM_MIN_CHECK = 1024  # smaller payloads are never in shared memory here: skip a
 DEFAULT_SOURCE = "the default session config"
 #: the "no zenoh router" warning is given once a process
 _router_warned = threading.Event()
-#: received samples a topic holds for the main loop at most (a loop that stalled for longer than this
-#: many messages loses the oldest, counted as ``backlog`` drops); KEEP_LAST subscriptions keep their depth
+#: received samples the transport holds for the main loop at most (a loop that stalled for longer than
+#: this many messages loses the oldest, counted as ``backlog`` drops); KEEP_LAST subscriptions keep their depth
 BACKLOG_LIMIT = 10_000
-#: messages the main loop injects before it lets the subscriptions' dispatchers run (bounded by their depth)
+#: samples of one topic the main loop injects before it lets the subscriptions' dispatchers run
+#: (fewer when the topic's smallest depth is smaller), and of all topics together
 MAX_CHUNK = 64
+MAX_DRAIN = 256
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
 
@@ -329,11 +331,9 @@ class _Outbound:
 class _Inbound:
     """One topic's zenoh subscriber; hands checked, decoded messages to the bus.
 
-    zenoh's thread only queues a sample and, when none was waiting, wakes the main loop
-    (one ``call_soon_threadsafe`` per batch of samples that arrive together). The loop
-    checks, decodes and injects them, at most as many per turn as the smallest depth of
-    the topic's subscriptions before their dispatchers run: a burst that piled up while
-    the process was descheduled fills no subscription queue past its depth.
+    zenoh's thread only queues a sample in the transport's one queue (all topics, in
+    arrival order); :meth:`ZenohTransport._drain` checks, decodes and injects them on the
+    main loop.
     """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
@@ -349,9 +349,6 @@ class _Inbound:
         self.depth = 0
         self.chunk = MAX_CHUNK
         self.fallback = _Injector(transport._owner, msg_type, topic, _FALLBACK_QOS, "<zenoh>", hidden=True)
-        self._pending: deque[Any] = deque()
-        self._armed = False  # a drain is due on the loop
-        self._arming = threading.Lock()
         self._injector: _Injector | None = None  # the injector of the last sample's GID
         self._gid = b""
 
@@ -397,45 +394,8 @@ class _Inbound:
             old.undeclare()
 
     def _on_sample(self, sample: Any) -> None:
-        """On a zenoh thread: queue the sample; wake the loop unless a drain is already due."""
-        pending = self._pending
-        if len(pending) >= BACKLOG_LIMIT:
-            pending.popleft()
-            self.transport._warn(
-                "backlog", f"dropped the oldest sample on {self.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
-            )
-        pending.append(sample)
-        if not self._armed:
-            with self._arming:
-                if self._armed:
-                    return
-                self._armed = True
-            self.transport._to_loop(self._drain)
-
-    def _drain(self) -> None:
-        """On the main loop: decode and inject up to ``chunk`` queued samples, then let the
-        dispatchers run before the next chunk (one drain is due at a time)."""
-        pending = self._pending
-        transport = self.transport
-        local = transport._local
-        local.injecting = True
-        try:
-            for _ in range(self.chunk):
-                if not pending:
-                    break
-                decoded = self._decode(pending.popleft())
-                if decoded is not None:
-                    self._inject(*decoded)
-        finally:
-            local.injecting = False
-        loop = transport._loop
-        if not pending or loop is None or loop.is_closed():
-            with self._arming:
-                self._armed = False
-                if not pending or loop is None or loop.is_closed():
-                    return
-                self._armed = True  # a sample came in between: it would wait for the next one
-        loop.call_soon(self._drain)
+        """On a zenoh thread: queue the sample for the main loop."""
+        self.transport._queue(self, sample)
 
     def _decode(self, sample: Any) -> tuple[bytes, Any] | None:
         """Check a sample (key, attachment, CDR) and decode it: ``(gid, message)``, or None when dropped."""
@@ -487,7 +447,6 @@ class _Inbound:
         if self.zsub is not None:
             self.zsub.undeclare()
             self.zsub = None
-        self._pending.clear()
 
 
 class ZenohTransport(Transport):
@@ -570,6 +529,10 @@ class ZenohTransport(Transport):
         self._received_shm = 0
         self._drops_shm_full = 0  # sends that fell back to the network because the pool was full
         self._shm_lock = threading.Lock()
+        # received samples on their way to the main loop: (inbound, sample), in arrival order
+        self._pending: deque[tuple[_Inbound, Any]] = deque()
+        self._armed = False  # a drain is due on the loop
+        self._arming = threading.Lock()
 
     def __repr__(self) -> str:
         state = f"zid={self._zid}" if self._session is not None else "closed"
@@ -658,6 +621,7 @@ class ZenohTransport(Transport):
                 token.undeclare()
             self._outbound.clear()
             self._inbound.clear()
+            self._pending.clear()
             self._queryables.clear()
             self._tokens.clear()
             self._nodes.clear()
@@ -740,6 +704,58 @@ class ZenohTransport(Transport):
     def _to_loop(self, fn: Any, *args: Any) -> None:
         if self._loop is not None:
             post(self._loop, fn, *args)
+
+    def _queue(self, inbound: _Inbound, sample: Any) -> None:
+        """On a zenoh thread: queue a received sample; wake the loop unless a drain is already due
+        (one ``call_soon_threadsafe`` per batch of samples that arrive together)."""
+        pending = self._pending
+        if len(pending) >= BACKLOG_LIMIT:
+            lost, _ = pending.popleft()
+            self._warn(
+                "backlog", f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
+            )
+        pending.append((inbound, sample))
+        if not self._armed:
+            with self._arming:
+                if self._armed:
+                    return
+                self._armed = True
+            self._to_loop(self._drain)
+
+    def _drain(self) -> None:
+        """On the main loop: decode and inject queued samples in arrival order, at most ``chunk`` of
+        one topic (its smallest subscription depth) before the dispatchers run; then the next drain.
+        One drain is due at a time; samples that pile up while the process is descheduled so never
+        fill a subscription queue past its depth, and topics keep their relative order."""
+        pending = self._pending
+        local = self._local
+        taken: dict[int, int] = {}
+        local.injecting = True
+        try:
+            for _ in range(MAX_DRAIN):
+                if not pending:
+                    break
+                inbound, sample = pending[0]
+                n = taken.get(id(inbound), 0)
+                if n >= inbound.chunk:
+                    break
+                pending.popleft()
+                taken[id(inbound)] = n + 1
+                if inbound.zsub is None:
+                    continue  # the topic's last subscription left meanwhile
+                decoded = inbound._decode(sample)
+                if decoded is not None:
+                    inbound._inject(*decoded)
+        finally:
+            local.injecting = False
+        loop = self._loop
+        if not pending or loop is None or loop.is_closed():
+            with self._arming:
+                self._armed = False
+                if not pending or loop is None or loop.is_closed():
+                    return
+                self._armed = True  # a sample came in between: it would wait for the next one
+        loop.call_soon(self._drain)
 
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)
