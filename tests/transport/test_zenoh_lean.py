@@ -3,6 +3,8 @@ processes, and a received image's pixels are a read-only view into the payload, 
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import AsyncIterator
 from typing import Any
 
 import numpy as np
@@ -26,16 +28,20 @@ async def main(rt):
     say("ready")
     reader = await stdin_lines()
     loop = asyncio.get_running_loop()
-    while (await reader.readline()).decode().strip() == "ping":  # until the route is up: one marked message
+    while (line := (await reader.readline()).decode().strip()) == "ping":  # until the route is up
         pub.publish(Twist(linear=Vector3(x=-1.0)))
         say("pinged")
+    how, count = line.split()
     start = loop.time()
-    for i in range(%d):  # 1 kHz on the loop's clock: a steady stream, not a burst
+    for i in range(int(count)):
         pub.publish(Twist(linear=Vector3(x=float(i))))
-        await asyncio.sleep(max(0.0, start + (i + 1) / 1000 - loop.time()))
+        if how == "steady":  # 1 kHz on the loop's clock
+            await asyncio.sleep(max(0.0, start + (i + 1) / 1000 - loop.time()))
+        elif i % 50 == 49:  # a burst, yielding now and then
+            await asyncio.sleep(0)
     say("done", rt.transport.statistics().sent)
     await reader.readline()
-""" % COUNT
+"""
 
 CAMERA = """
 import numpy as np
@@ -67,36 +73,38 @@ async def _first_arrival(child: Child, rt: Runtime, topic: str, got: list[Any]) 
     raise AssertionError(f"nothing arrived on {topic}")
 
 
-def _runtime(port: int) -> Runtime:
-    return Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False)
+@contextlib.asynccontextmanager
+async def _beside(code: str, port: int, name: str) -> AsyncIterator[tuple[Child, Runtime, Node]]:
+    """A child process running ``code``, and a runtime here with one node, both on the router at ``port``."""
+    child = await spawn(code, port)
+    try:
+        await child.expect("ready")
+        async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
+            yield child, rt, rt.add_node(Node(name))
+    finally:
+        await child.stop()
 
 
 async def test_a_steady_1khz_twist_stream_at_depth_10_arrives_whole_and_in_order(router_port: int) -> None:
-    child = await spawn(DRIVER, router_port)
-    try:
-        await child.expect("ready")
-        async with _runtime(router_port) as rt:
-            node = rt.add_node(Node("base"))
-            got: list[int] = []
-            qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-            sub = node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), qos)
-            await _first_arrival(child, rt, "/cmd_vel", got)
-            assert set(got) == {-1}
-            child.send("go")
-            line = await child.expect("done")
-            assert int(line.split()[1]) >= COUNT
-            stream = lambda: [x for x in got if x >= 0]  # noqa: E731 - (a late ping is no part of it)
-            try:
-                await wait_until(lambda: len(stream()) >= COUNT)
-            except TimeoutError:
-                missing = sorted(set(range(COUNT)) - set(stream()))
-                raise AssertionError(f"{len(missing)} lost, first {missing[:20]}; {rt.transport.statistics()}") from None
-            assert stream() == list(range(COUNT))
-            assert sub.dropped == 0
-            assert rt.transport.statistics().dropped == 0
-            child.send("bye")
-    finally:
-        await child.stop()
+    async with _beside(DRIVER, router_port, "base") as (child, rt, node):
+        got: list[int] = []
+        qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        sub = node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), qos)
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        assert set(got) == {-1}
+        child.send(f"steady {COUNT}")
+        line = await child.expect("done")
+        assert int(line.split()[1]) >= COUNT
+        stream = lambda: [x for x in got if x >= 0]  # noqa: E731 - (a late ping is no part of it)
+        try:
+            await wait_until(lambda: len(stream()) >= COUNT)
+        except TimeoutError:
+            missing = sorted(set(range(COUNT)) - set(stream()))
+            raise AssertionError(f"{len(missing)} lost, first {missing[:20]}; {rt.transport.statistics()}") from None
+        assert stream() == list(range(COUNT))
+        assert sub.dropped == 0
+        assert rt.transport.statistics().dropped == 0
+        child.send("bye")
 
 
 def _root(a: np.ndarray) -> object:
@@ -117,40 +125,14 @@ def test_deserialize_view_shares_the_input_and_the_default_copies() -> None:
 
 
 async def test_a_received_image_is_a_read_only_view_into_the_payload(router_port: int) -> None:
-    child = await spawn(CAMERA, router_port)
-    try:
-        await child.expect("ready")
-        async with _runtime(router_port) as rt:
-            node = rt.add_node(Node("viewer"))
-            images: list[Image] = []
-            node.create_subscription(Image, "/image", images.append, 5)
-            await _first_arrival(child, rt, "/image", images)
-            data = images[0].data
-            assert np.array_equal(data, (np.arange(320 * 240 * 3) % 251).astype(np.uint8))
-            assert not data.flags.writeable and not data.flags.owndata
-            assert isinstance(_root(data), bytes)  # the payload's bytes, decoded in place
-    finally:
-        await child.stop()
-
-
-BURSTER = """
-from aiorobot.msgs.geometry_msgs import Twist, Vector3
-async def main(rt):
-    node = Node("burster")
-    rt.add_node(node)
-    pub = node.create_publisher(Twist, "/burst", QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
-    say("ready")
-    reader = await stdin_lines()
-    while (line := (await reader.readline()).decode().strip()) == "ping":
-        pub.publish(Twist(linear=Vector3(x=-1.0)))
-        say("pinged")
-    for i in range(int(line)):
-        pub.publish(Twist(linear=Vector3(x=float(i))))
-        if i % 50 == 49:
-            await asyncio.sleep(0)
-    say("done")
-    await reader.readline()
-"""
+    async with _beside(CAMERA, router_port, "viewer") as (child, rt, node):
+        images: list[Image] = []
+        node.create_subscription(Image, "/image", images.append, 5)
+        await _first_arrival(child, rt, "/image", images)
+        data = images[0].data
+        assert np.array_equal(data, (np.arange(320 * 240 * 3) % 251).astype(np.uint8))
+        assert not data.flags.writeable and not data.flags.owndata
+        assert isinstance(_root(data), bytes)  # the payload's bytes, decoded in place
 
 
 async def test_a_loop_stalled_past_the_backlog_limit_loses_the_oldest_and_says_so(
@@ -161,28 +143,22 @@ async def test_a_loop_stalled_past_the_backlog_limit_loses_the_oldest_and_says_s
     from aiorobot.transport import _zenoh
 
     monkeypatch.setattr(_zenoh, "BACKLOG_LIMIT", 50)
-    child = await spawn(BURSTER, router_port)
-    try:
-        await child.expect("ready")
-        async with _runtime(router_port) as rt:
-            node = rt.add_node(Node("slow"))
-            got: list[int] = []
-            node.create_subscription(Twist, "/burst", lambda m: got.append(int(m.linear.x)), QoSProfile(depth=100))
-            await _first_arrival(child, rt, "/burst", got)
-            child.send("300")
-            assert child.proc.stdin is not None
-            await child.proc.stdin.drain()
-            # the main loop stalls (a blocking call) while zenoh's thread keeps receiving the burst
-            deadline = time.monotonic() + 20
-            while rt.transport.statistics().drop_reasons.get("backlog", 0) == 0 and time.monotonic() < deadline:
-                time.sleep(0.01)
-            backlog = rt.transport.statistics().drop_reasons.get("backlog", 0)
-            assert backlog > 0
-            await child.expect("done")
-            await wait_until(lambda: bool(got) and got[-1] == 299)
-            stream = [x for x in got if x >= 0]
-            assert stream == sorted(stream) and len(stream) <= 300 - backlog  # the oldest went, in order
-            assert any("50 were waiting for the main loop" in r.getMessage() for r in caplog.records)
-            child.send("bye")
-    finally:
-        await child.stop()
+    async with _beside(DRIVER, router_port, "slow") as (child, rt, node):
+        got: list[int] = []
+        node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), QoSProfile(depth=100))
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        child.send("burst 300")
+        assert child.proc.stdin is not None
+        await child.proc.stdin.drain()
+        # the main loop stalls (a blocking call) while zenoh's thread keeps receiving the burst
+        deadline = time.monotonic() + 20
+        while rt.transport.statistics().drop_reasons.get("backlog", 0) == 0 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        backlog = rt.transport.statistics().drop_reasons.get("backlog", 0)
+        assert backlog > 0
+        await child.expect("done")
+        await wait_until(lambda: bool(got) and got[-1] == 299)
+        stream = [x for x in got if x >= 0]
+        assert stream == sorted(stream) and len(stream) <= 300 - backlog  # the oldest went, in order
+        assert any("50 were waiting for the main loop" in r.getMessage() for r in caplog.records)
+        child.send("bye")
