@@ -2,13 +2,15 @@
 
 * A local publisher gets an rmw_zenoh liveliness token; its topic gets one zenoh
   publisher fed by a hidden *sender tap* on the bus, which serialises to CDR in the
-  publishing thread and puts with the 33-byte attachment. Same-process subscribers
-  keep zero-copy delivery: they never see the tap.
+  publishing thread and puts with the 33-byte attachment (only while a remote
+  subscriber matches). Same-process subscribers keep zero-copy delivery: they never
+  see the tap.
 * A local subscription gets a token; its topic gets one zenoh subscriber (an
-  advanced one with history for transient local). Samples are checked (key, type
-  hash, attachment, CDR) and deserialised on zenoh's thread, then handed to the
-  main loop with ``call_soon_threadsafe``, where an *injector* (a publisher standing
-  for the remote one) publishes them into the bus.
+  advanced one with history for transient local). zenoh's thread queues each sample
+  (one queue, arrival order) and wakes the main loop once per batch; there samples
+  are checked (key, type hash, attachment, CDR), decoded (arrays as views into the
+  payload) and published into the bus by an *injector* (a publisher standing for the
+  remote one), a topic's depth at most per loop turn.
 * Remote endpoints learnt from liveliness tokens join the bus as endpoints of their
   own (injectors for publishers, passive taps for subscriptions, remote servers and
   clients for services), so ``Runtime.graph``, ``count_subscribers``,
