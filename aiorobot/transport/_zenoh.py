@@ -735,13 +735,14 @@ class ZenohTransport(Transport):
         local.injecting = True
         try:
             for _ in range(MAX_DRAIN):
-                if not pending:
+                try:
+                    inbound, sample = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
+                except IndexError:
                     break
-                inbound, sample = pending[0]
                 n = taken.get(id(inbound), 0)
                 if n >= inbound.chunk:
+                    pending.appendleft(item)  # the topic's dispatchers run first
                     break
-                pending.popleft()
                 taken[id(inbound)] = n + 1
                 if inbound.zsub is None:
                     continue  # the topic's last subscription left meanwhile
