@@ -1,8 +1,21 @@
-"""``aiorobot bench latency`` zenoh rows: two processes on loopback, one-way latency and throughput.
+"""``aiorobot bench latency`` zenoh rows: the same message pair through every path a Python robot
+developer could pick, each a pair of processes, interleaved in one run.
 
-A child process subscribes; the parent publishes messages stamped with
-``time.monotonic_ns()`` (one clock for every process on a Linux host), and the
-child reports one-way latency (receive minus stamp) and the receive rate of a burst.
+Paths (each one a sender process and a receiver process of its own):
+
+- ``aiorobot``: a Runtime with a ZenohTransport in each process (a Twist, a 640x480x3 Image);
+- ``zenoh``: bare zenoh-python, the same session config (the transport's defaults: batching off,
+  shared memory on, through the same router), ``put`` -> callback; the image put from a
+  ``ShmProvider`` buffer;
+- ``iceoryx2``: iceoryx2 pub/sub with an event to wake the receiver, when ``iceoryx2`` is
+  importable; the image written once into a loaned sample;
+- ``dora-rs`` is listed when importable but not measured (its nodes run under a dora daemon and
+  dataflow, which this bench does not start).
+
+The sender stamps each message with ``time.monotonic_ns()`` (one clock for every process of a Linux
+host); the receiver reports one-way latency (receive minus stamp) and, for a burst sent back to
+back, how many arrived and at what rate. Rounds go through the paths in turn, so the machine's
+load falls on all of them alike; figures are pooled over the rounds.
 """
 
 from __future__ import annotations
@@ -15,54 +28,325 @@ import sys
 import time
 from typing import Any
 
-__all__ = ["run", "table"]
+__all__ = ["PATHS", "available_paths", "run", "table"]
 
-_CHILD = r"""
-import asyncio, json, sys, time
-import aiorobot
-from aiorobot import Node, Runtime, QoSProfile, HistoryPolicy
-from aiorobot.transport import ZenohTransport
-from aiorobot.msgs.geometry_msgs import Twist
-from aiorobot.msgs.sensor_msgs import Image
+PATHS = ("aiorobot", "zenoh", "iceoryx2", "dora-rs")
+SMALL_BYTES = 52  # a Twist's CDR
+IMAGE_BYTES = 640 * 480 * 3
+SMALL_HZ = 1000.0
+IMAGE_HZ = 30.0
+_SERVICE = "aiorobot/bench/zenoh"
 
-async def main(port, shm):
-    lat = {"twist": [], "image": [], "raw": []}
-    burst = {"n": 0, "first": 0, "last": 0}
-    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"], shared_memory=shm), handle_signals=False) as rt:
+
+def available_paths() -> dict[str, str | None]:
+    """Each path, and why it cannot run here (None: it can)."""
+    import importlib.util
+
+    out: dict[str, str | None] = {"aiorobot": None, "zenoh": None}
+    out["iceoryx2"] = None if importlib.util.find_spec("iceoryx2") else "not installed (pip install iceoryx2)"
+    out["dora-rs"] = (
+        "needs a dora daemon and dataflow (not started by this bench)"
+        if importlib.util.find_spec("dora")
+        else "not installed (pip install dora-rs)"
+    )
+    return out
+
+
+# -- the peers (run as ``python -m aiorobot.bench._zenoh ROLE PATH PORT``) ------------------------------
+
+
+class _Record:
+    """What a receiver saw since its last report."""
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        self.lat: dict[str, list[int]] = {"small": [], "image": []}
+        self.burst = {"n": 0, "first": 0, "last": 0}
+
+    def got(self, kind: int, stamp: int) -> None:
+        now = time.monotonic_ns()
+        if kind == 1:
+            b = self.burst
+            b["n"] += 1
+            b["first"] = b["first"] or now
+            b["last"] = now
+        else:
+            self.lat["small" if kind == 0 else "image"].append(now - stamp)
+
+    def report(self) -> str:
+        line = json.dumps({"lat": self.lat, "burst": self.burst})
+        self.reset()
+        return line
+
+
+def _stamp_bytes(kind: int, size: int) -> bytes:
+    return time.monotonic_ns().to_bytes(8, "little") + bytes((kind,)) + bytes(size - 9)
+
+
+def _unstamp(data: Any) -> tuple[int, int]:
+    return data[8], int.from_bytes(bytes(data[:8]), "little")
+
+
+async def _aiorobot_receiver(port: int) -> None:
+    from .. import Node, QoSProfile, Runtime
+    from ..msgs.geometry_msgs import Twist
+    from ..msgs.sensor_msgs import Image
+    from ..transport import ZenohTransport
+
+    rec = _Record()
+    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
         node = rt.add_node(Node("bench_sink"))
-        def on_twist(m):
-            now = time.monotonic_ns()
-            if m.linear.y == 1.0:
-                burst["n"] += 1
-                burst["first"] = burst["first"] or now
-                burst["last"] = now
-            else:
-                lat["twist"].append(now - int(m.linear.x))
-        def on_image(m):
-            lat["image"].append(time.monotonic_ns() - (m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec))
-        keep_all = QoSProfile(history=HistoryPolicy.KEEP_ALL)
-        node.create_subscription(Twist, "/bench/twist", on_twist, keep_all)
-        node.create_subscription(Image, "/bench/image", on_image, keep_all)
-        raw = rt.transport._session.declare_subscriber(
-            "bench/raw", lambda s: lat["raw"].append(time.monotonic_ns() - int.from_bytes(s.payload.to_bytes()[:8], "little")))
-        print("ready", flush=True)
-        loop = asyncio.get_running_loop()
-        reader = asyncio.StreamReader()
-        await loop.connect_read_pipe(lambda: asyncio.StreamReaderProtocol(reader), sys.stdin)
-        while line := (await reader.readline()).decode().strip():
-            if line == "report":
-                print(json.dumps({"lat": lat, "burst": burst, "received_shm": rt.transport.statistics().received_shm}), flush=True)
-                lat = {"twist": [], "image": [], "raw": []}
-                burst.update(n=0, first=0, last=0)
+        node.create_subscription(Twist, "/bench/twist", lambda m: rec.got(int(m.linear.y), int(m.linear.x)), QoSProfile(depth=10))
+        node.create_subscription(
+            Image, "/bench/image",
+            lambda m: rec.got(2, m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec), QoSProfile(depth=10),
+        )
+        await _serve_stdin(lambda cmd: rec.report())
 
-aiorobot.run(main(int(sys.argv[1]), sys.argv[2] == "shm"))
-"""
+
+async def _aiorobot_sender(port: int) -> None:
+    import numpy as np
+
+    from .. import Node, QoSProfile, Runtime
+    from ..msgs.geometry_msgs import Twist, Vector3
+    from ..msgs.sensor_msgs import Image
+    from ..transport import ZenohTransport
+
+    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
+        node = rt.add_node(Node("bench_source"))
+        twist = node.create_publisher(Twist, "/bench/twist", QoSProfile(depth=10))
+        image = node.create_publisher(Image, "/bench/image", QoSProfile(depth=10))
+        data = np.zeros(IMAGE_BYTES, dtype=np.uint8)
+
+        def small(kind: int) -> None:
+            twist.publish(Twist(linear=Vector3(x=float(time.monotonic_ns()), y=float(kind))))
+
+        def picture() -> None:
+            msg = Image(height=480, width=640, encoding="rgb8", step=640 * 3, data=data)
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(time.monotonic_ns(), 1_000_000_000)
+            image.publish(msg)
+
+        await _serve_stdin(_sender_commands(small, picture))
+
+
+async def _zenoh_receiver(port: int) -> None:
+    import zenoh
+
+    from ..transport._zenoh import build_session_config
+
+    rec = _Record()
+    cfg, _ = build_session_config(connect=[f"tcp/127.0.0.1:{port}"])
+    session = zenoh.open(cfg)
+
+    def on_sample(sample: Any) -> None:
+        data = sample.payload.to_bytes()
+        rec.got(*_unstamp(data))
+
+    sub = session.declare_subscriber(f"{_SERVICE}/*", on_sample)
+    try:
+        await _serve_stdin(lambda cmd: rec.report())
+    finally:
+        sub.undeclare()
+        session.close()
+
+
+async def _zenoh_sender(port: int) -> None:
+    import zenoh
+    from zenoh.shm import GarbageCollect, ShmProvider
+
+    from ..transport._zenoh import build_session_config
+
+    cfg, _ = build_session_config(connect=[f"tcp/127.0.0.1:{port}"])
+    session = zenoh.open(cfg)
+    shm = ShmProvider.default_backend(48 * 1024 * 1024)
+    pub = session.declare_publisher(f"{_SERVICE}/small", congestion_control=zenoh.CongestionControl.DROP)
+    img = session.declare_publisher(f"{_SERVICE}/image", congestion_control=zenoh.CongestionControl.DROP)
+    pixels = bytes(IMAGE_BYTES - 9)
+
+    def small(kind: int) -> None:
+        pub.put(_stamp_bytes(kind, SMALL_BYTES))
+
+    def picture() -> None:
+        buf = shm.alloc(IMAGE_BYTES, GarbageCollect())
+        buf[:9] = time.monotonic_ns().to_bytes(8, "little") + b"\x02"
+        buf[9:] = pixels
+        img.put(buf)
+
+    try:
+        await _serve_stdin(_sender_commands(small, picture))
+    finally:
+        session.close()
+
+
+async def _iceoryx2_receiver(port: int) -> None:
+    import ctypes
+
+    import iceoryx2 as iox2
+
+    rec = _Record()
+    node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
+    subs = []
+    for name in ("small", "image"):
+        service = (
+            node.service_builder(iox2.ServiceName.new(f"{_SERVICE}/{port}/{name}"))
+            .publish_subscribe(iox2.Slice[ctypes.c_uint8])
+            .subscriber_max_buffer_size(64)
+            .open_or_create()
+        )
+        subs.append(service.subscriber_builder().buffer_size(64).create())
+    event = node.service_builder(iox2.ServiceName.new(f"{_SERVICE}/{port}/event")).event().open_or_create()
+    listener = event.listener_builder().create()
+    stop = False
+
+    def pump() -> None:
+        while not stop:
+            if not listener.timed_wait(iox2.Duration.from_millis(100)):
+                continue
+            for sub in subs:
+                while (sample := sub.receive()) is not None:
+                    view = sample.payload().as_memory_view().cast("B")
+                    rec.got(*_unstamp(view))
+                    del view, sample
+
+    task = asyncio.ensure_future(asyncio.to_thread(pump))
+    print("ready", flush=True)
+    await _serve_stdin(lambda cmd: rec.report(), announce=False)
+    stop = True
+    await task
+
+
+async def _iceoryx2_sender(port: int) -> None:
+    import ctypes
+
+    import iceoryx2 as iox2
+    import numpy as np
+
+    node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
+    pubs = {}
+    for name, size in (("small", SMALL_BYTES), ("image", IMAGE_BYTES)):
+        service = (
+            node.service_builder(iox2.ServiceName.new(f"{_SERVICE}/{port}/{name}"))
+            .publish_subscribe(iox2.Slice[ctypes.c_uint8])
+            .subscriber_max_buffer_size(64)
+            .open_or_create()
+        )
+        pubs[name] = service.publisher_builder().initial_max_slice_len(size).max_loaned_samples(4).create()
+    event = node.service_builder(iox2.ServiceName.new(f"{_SERVICE}/{port}/event")).event().open_or_create()
+    notifier = event.notifier_builder().create()
+    pixels = np.zeros(IMAGE_BYTES, dtype=np.uint8)
+
+    def send(name: str, head: bytes, body: Any, size: int) -> None:
+        sample = pubs[name].loan_slice_uninit(size)
+        ptr = sample.payload().as_ptr()
+        ctypes.memmove(ptr, head, len(head))
+        if body is not None:
+            ctypes.memmove(ptr + len(head), body.ctypes.data, size - len(head))
+        sample.assume_init().send()
+        notifier.notify()
+
+    def small(kind: int) -> None:
+        send("small", _stamp_bytes(kind, SMALL_BYTES), None, SMALL_BYTES)
+
+    def picture() -> None:
+        send("image", time.monotonic_ns().to_bytes(8, "little") + b"\x02", pixels[9:], IMAGE_BYTES)
+
+    await _serve_stdin(_sender_commands(small, picture))
+
+
+def _sender_commands(small: Any, picture: Any) -> Any:
+    """A sender's command handler: ``small N`` at 1 kHz, ``image N`` at 30 Hz, ``burst N`` back to back."""
+
+    async def handle(cmd: str) -> str:
+        verb, count = cmd.split()
+        n = int(count)
+        start = time.perf_counter()
+        if verb == "burst":
+            for i in range(n):
+                small(1)
+                if i % 500 == 499:
+                    await asyncio.sleep(0)  # a long burst must not read as a stalled loop
+            return json.dumps({"sent": n, "send_sec": time.perf_counter() - start})
+        period = 1.0 / (SMALL_HZ if verb == "small" else IMAGE_HZ)
+        send = (lambda: small(0)) if verb == "small" else picture
+        cost: list[int] = []  # how long the publish call itself takes (perf_counter_ns)
+        for i in range(n):
+            t0 = time.perf_counter_ns()
+            send()
+            cost.append(time.perf_counter_ns() - t0)
+            delay = start + (i + 1) * period - time.perf_counter()
+            await asyncio.sleep(max(delay, 0.0))
+        return json.dumps({"sent": n, "send_sec": time.perf_counter() - start, "cost": cost})
+
+    return handle
+
+
+async def _serve_stdin(handle: Any, *, announce: bool = True) -> None:
+    """Answer one line of stdout per command line on stdin, until stdin closes."""
+    loop = asyncio.get_running_loop()
+    reader = asyncio.StreamReader()
+    await loop.connect_read_pipe(lambda: asyncio.StreamReaderProtocol(reader), sys.stdin)
+    if announce:
+        print("ready", flush=True)
+    while line := (await reader.readline()).decode().strip():
+        result = handle(line)
+        if asyncio.iscoroutine(result):
+            result = await result
+        print(result, flush=True)
+
+
+_ROLES = {
+    ("recv", "aiorobot"): _aiorobot_receiver,
+    ("send", "aiorobot"): _aiorobot_sender,
+    ("recv", "zenoh"): _zenoh_receiver,
+    ("send", "zenoh"): _zenoh_sender,
+    ("recv", "iceoryx2"): _iceoryx2_receiver,
+    ("send", "iceoryx2"): _iceoryx2_sender,
+}
+
+
+# -- the parent -----------------------------------------------------------------------------------
 
 
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
+
+
+class _Peer:
+    """A child process answering one stdout line per stdin command."""
+
+    def __init__(self, role: str, path: str, port: int) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "aiorobot.bench._zenoh", role, path, str(port)],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+        )
+        self.role, self.path = role, path
+
+    def ready(self) -> str | None:
+        assert self.proc.stdout is not None
+        line = self.proc.stdout.readline().strip()
+        return None if line == "ready" else f"the {self.path} {self.role} process did not start ({line or 'no output'})"
+
+    def ask(self, command: str) -> dict[str, Any]:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(command + "\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError(f"the {self.path} {self.role} process ended (exit status {self.proc.wait()})")
+        return dict(json.loads(line))
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
 
 
 def _stats(values_ns: list[int]) -> dict[str, Any]:
@@ -75,142 +359,169 @@ def _stats(values_ns: list[int]) -> dict[str, Any]:
 
 
 def run(quick: bool = False) -> dict[str, Any]:
-    """Twist one-way p50/p99 and msgs/s, and a 640x480x3 Image one-way, across two processes.
-
-    Two passes, each with its own subscriber process: shared memory on (Twist, the bare
-    zenoh baseline, the burst, the Image through shared memory), then off in both processes
-    (the Image through the network stack, what a peer on another host gets).
-    """
-    from ._noise import NoiseMeter
-
-    with NoiseMeter() as meter:
-        figures = _pass(quick, shm=True)
-        if "error" not in figures:
-            copy = _pass(quick, shm=False)
-            figures["image_copy"] = copy.get("image", {"n": 0, "error": copy.get("error")})
-        figures["image_shm"] = figures.pop("image", {"n": 0})
-    return {**figures, "noise": meter.result.as_dict()}
-
-
-def _pass(quick: bool, *, shm: bool) -> dict[str, Any]:
+    """Each available path's small-message and image one-way latency and burst rate, interleaved."""
     import zenoh
 
-    from .. import run as aiorun
+    from ._noise import NoiseMeter
 
+    rounds, n_small, n_image, n_burst = (1, 200, 10, 2000) if quick else (3, 2000, 100, 20000)
+    reasons = available_paths()
+    paths = [p for p, why in reasons.items() if why is None]
     port = _free_port()
     cfg = zenoh.Config()
     cfg.insert_json5("mode", '"router"')
     cfg.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
     cfg.insert_json5("scouting/multicast/enabled", "false")
     router = zenoh.open(cfg)
-    child = subprocess.Popen(
-        [sys.executable, "-c", _CHILD, str(port), "shm" if shm else "copy"],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-    )
-    try:
-        assert child.stdout is not None and child.stdin is not None
-        if child.stdout.readline().strip() != "ready":
-            return {"error": "the subscriber process did not start"}
-        return aiorun(_measure(port, child, quick, shm=shm))
-    finally:
-        child.kill()
-        child.wait()
-        router.close()
-
-
-async def _measure(port: int, child: subprocess.Popen[str], quick: bool, *, shm: bool) -> dict[str, Any]:
-    from .. import HistoryPolicy, Node, QoSProfile, Runtime
-    from ..msgs.geometry_msgs import Twist, Vector3
-    from ..msgs.sensor_msgs import Image
-    from ..transport import ZenohTransport
-
-    n_lat, n_burst, n_img = (300, 5000, 30) if quick else (2000, 50000, 200)
-    keep_all = QoSProfile(history=HistoryPolicy.KEEP_ALL)
-    transport = ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"], shared_memory=shm)
-    async with Runtime(transport=transport, handle_signals=False) as rt:
-        node = rt.add_node(Node("bench_source"))
-        twist = node.create_publisher(Twist, "/bench/twist", keep_all)
-        image = node.create_publisher(Image, "/bench/image", keep_all)
-        deadline = time.monotonic() + 10
-        while (twist.get_subscription_count() == 0 or image.get_subscription_count() == 0) and time.monotonic() < deadline:
-            await asyncio.sleep(0.01)
-        for _ in range(50):  # warm-up
-            twist.publish(Twist(linear=Vector3(x=float(time.monotonic_ns()))))
-            await asyncio.sleep(0.001)
-        first = await _report(child)
-        await _send_images(image, n_img)
-        report = await _report(child)
-        images = {**_stats(report["lat"]["image"]), "sent_shm": transport.statistics().sent_shm,
-                  "received_shm": report["received_shm"] - first["received_shm"]}
-        if not shm:
-            return {"image": images}
-        raw = transport._session.declare_publisher("bench/raw")
-        for _ in range(n_lat):
-            twist.publish(Twist(linear=Vector3(x=float(time.monotonic_ns()))))
-            await asyncio.sleep(0.0005)
-            raw.put(time.monotonic_ns().to_bytes(8, "little") + bytes(44))  # same size as a Twist's CDR
-            await asyncio.sleep(0.0005)
-        await asyncio.sleep(0.5)
-        lat = (await _report(child))["lat"]
-        start = time.perf_counter()
-        for _ in range(n_burst):
-            twist.publish(Twist(linear=Vector3(y=1.0)))
-        send_sec = time.perf_counter() - start
-        await asyncio.sleep(1.0)
-        burst = (await _report(child))["burst"]
-    recv_sec = max((burst["last"] - burst["first"]) / 1e9, 1e-9)
-    return {
-        "twist": _stats(lat["twist"]),
-        "raw_zenoh": _stats(lat["raw"]),
-        "image": images,
-        "burst": {"sent": n_burst, "received": burst["n"], "send_msgs_per_sec": n_burst / send_sec,
-                  "recv_msgs_per_sec": burst["n"] / recv_sec},
+    pairs: dict[str, tuple[_Peer, _Peer]] = {}
+    pooled: dict[str, dict[str, Any]] = {
+        p: {"small": [], "image": [], "burst": [], "small_sent": 0, "image_sent": 0, "small_cost": [], "image_cost": []}
+        for p in paths
     }
+    errors: dict[str, str] = {}
+    try:
+        with NoiseMeter() as meter:
+            started = {path: (_Peer("recv", path, port), _Peer("send", path, port)) for path in paths}
+            for path, (recv, send) in started.items():
+                why = recv.ready() or send.ready()
+                if why is not None:
+                    errors[path] = why
+                    recv.close(), send.close()
+                    continue
+                pairs[path] = (recv, send)
+                try:
+                    _warm_up(recv, send)
+                except (RuntimeError, ValueError) as err:
+                    errors[path] = str(err)
+                    del pairs[path]
+                    send.close(), recv.close()
+            for r in range(rounds):
+                order = list(pairs)[r % max(len(pairs), 1):] + list(pairs)[: r % max(len(pairs), 1)]
+                for path in order:
+                    recv, send = pairs[path]
+                    try:
+                        _round(recv, send, pooled[path], n_small, n_image, n_burst)
+                    except (RuntimeError, ValueError) as err:
+                        errors[path] = str(err)
+        noise = meter.result.as_dict() if meter.result is not None else {}
+    finally:
+        for recv, send in pairs.values():
+            send.close()
+            recv.close()
+        router.close()
+    rows = {}
+    for path in paths:
+        if path in errors:
+            rows[path] = {"error": errors[path]}
+            continue
+        got = pooled[path]
+        rates = [b["received"] / max((b["last"] - b["first"]) / 1e9, 1e-9) for b in got["burst"] if b["received"] > 1]
+        rows[path] = {
+            "small": {**_stats(got["small"]), "sent": got["small_sent"], "send_call": _stats(got["small_cost"])},
+            "image": {**_stats(got["image"]), "sent": got["image_sent"], "send_call": _stats(got["image_cost"])},
+            "burst": {
+                "sent": sum(b["sent"] for b in got["burst"]),
+                "received": sum(b["received"] for b in got["burst"]),
+                "recv_msgs_per_sec": rates,
+            },
+        }
+    skipped = {p: why for p, why in reasons.items() if why is not None}
+    return {"paths": rows, "skipped": skipped, "rounds": rounds, "noise": noise}
 
 
-async def _send_images(image: Any, n: int) -> None:
-    import numpy as np
-
-    from ..msgs.sensor_msgs import Image
-
-    data = np.zeros(640 * 480 * 3, dtype=np.uint8)
-    for _ in range(n):
-        now = time.monotonic_ns()
-        msg = Image(height=480, width=640, encoding="rgb8", step=640 * 3, data=data)
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(now, 1_000_000_000)
-        image.publish(msg)
-        await asyncio.sleep(0.01)
-    await asyncio.sleep(0.3)
+def _warm_up(recv: _Peer, send: _Peer) -> None:
+    """Until a message gets through (routes and shared memory set up), then forget what came."""
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        send.ask("small 20")
+        send.ask("image 2")
+        if recv.ask("report")["lat"]["small"]:
+            _collect(recv, 1 << 30, "small", quiet_sec=0.1)  # what of the warm-up is still on its way
+            return
+    raise RuntimeError(f"nothing reached the {recv.path} receiver in 20 s")
 
 
-async def _report(child: subprocess.Popen[str]) -> dict[str, Any]:
-    assert child.stdin is not None and child.stdout is not None
-    child.stdin.write("report\n")
-    child.stdin.flush()
-    line = await asyncio.to_thread(child.stdout.readline)
-    return json.loads(line)
+def _round(recv: _Peer, send: _Peer, into: dict[str, Any], n_small: int, n_image: int, n_burst: int) -> None:
+    reply = send.ask(f"small {n_small}")
+    sent = reply["sent"]
+    into["small_sent"] += sent
+    into["small_cost"] += reply["cost"]
+    into["small"] += _collect(recv, sent, "small")["small"]
+    reply = send.ask(f"image {n_image}")
+    sent = reply["sent"]
+    into["image_sent"] += sent
+    into["image_cost"] += reply["cost"]
+    into["image"] += _collect(recv, sent, "image")["image"]
+    sent = send.ask(f"burst {n_burst}")["sent"]
+    burst = _collect(recv, sent, "burst")["burst"]
+    into["burst"].append({"sent": sent, "received": burst["n"], "first": burst["first"], "last": burst["last"]})
+
+
+def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.2) -> dict[str, Any]:
+    """The receiver's reports merged until ``expected`` messages of ``kind`` arrived or none came for
+    ``quiet_sec`` (what did not arrive by then was lost)."""
+    got: dict[str, Any] = {"small": [], "image": [], "burst": {"n": 0, "first": 0, "last": 0}}
+    last_change = time.monotonic()
+    while True:
+        report = recv.ask("report")
+        got["small"] += report["lat"]["small"]
+        got["image"] += report["lat"]["image"]
+        b, into = report["burst"], got["burst"]
+        if b["n"]:
+            into["n"] += b["n"]
+            into["first"] = into["first"] or b["first"]
+            into["last"] = b["last"]
+        n = into["n"] if kind == "burst" else len(got[kind])
+        if report["lat"]["small"] or report["lat"]["image"] or b["n"]:
+            last_change = time.monotonic()
+        if n >= expected or time.monotonic() - last_change > quiet_sec:
+            return got
+        time.sleep(0.02)
 
 
 def table(part: dict[str, Any]) -> Any:
     from ._report import figure_table
 
+    title = "zenoh transport and its peers (two processes each, loopback, interleaved rounds)"
     if "error" in part:
-        return figure_table("zenoh transport (two processes, loopback)", ("path", "note"), [("zenoh", part["error"])])
-    t, img, b = part["twist"], part["image_copy"], part["burst"]
-    shm = part.get("image_shm", {})
-    raw = part.get("raw_zenoh", {})
-    rows = [
-        ("bare zenoh-python put -> callback (baseline)", raw.get("p50_us", float("nan")), raw.get("p99_us", float("nan")), float("nan")),
-        ("Twist one-way", t.get("p50_us", float("nan")), t.get("p99_us", float("nan")), float(b["recv_msgs_per_sec"])),
-        ("Image 640x480x3 one-way (copy)", img.get("p50_us", float("nan")), img.get("p99_us", float("nan")), float("nan")),
-        ("Image 640x480x3 one-way (shared memory)", shm.get("p50_us", float("nan")), shm.get("p99_us", float("nan")), float("nan")),
-    ]
+        return figure_table(title, ("path", "note"), [("zenoh", part["error"])])
+    nan = float("nan")
+    rows: list[tuple[Any, ...]] = []
+    names = {
+        "aiorobot": "aiorobot Runtime + ZenohTransport",
+        "zenoh": "bare zenoh-python put -> callback",
+        "iceoryx2": "iceoryx2 pub/sub + event",
+    }
+    for path, fig in part.get("paths", {}).items():
+        if "error" in fig:
+            rows.append((names.get(path, path), fig["error"], "", "", "", "", "", ""))
+            continue
+        s, i, b = fig["small"], fig["image"], fig["burst"]
+        rates = b["recv_msgs_per_sec"]
+        rate = f"{min(rates) / 1000:.1f}-{max(rates) / 1000:.1f}k" if rates else "-"
+        rows.append((
+            names.get(path, path), s.get("p50_us", nan), s.get("p99_us", nan), i.get("p50_us", nan), i.get("p99_us", nan),
+            f"{rate} ({100 * b['received'] / max(b['sent'], 1):.0f} % of {b['sent']})",
+            s.get("send_call", {}).get("p50_us", nan), i.get("send_call", {}).get("p50_us", nan),
+        ))
+    for path, why in part.get("skipped", {}).items():
+        rows.append((path, f"not measured: {why}", "", "", "", "", "", ""))
     return figure_table(
-        "zenoh transport (two processes, loopback)",
-        ("path", "p50 us", "p99 us", "msgs/s"),
+        title,
+        ("path", "small p50 us", "small p99 us", "image p50 us", "image p99 us", "burst received msgs/s",
+         "send call p50 us (small)", "send call p50 us (image)"),
         rows,
-        caption=(
-            f"burst: {b['received']}/{b['sent']} received; shared-memory Images: {shm.get('sent_shm', 0)} put, "
-            f"{shm.get('received_shm', 0)} received in shared memory"
-        ),
+        caption=f"small: {SMALL_BYTES} bytes at {SMALL_HZ:.0f} Hz; image: 640x480x3 at {IMAGE_HZ:.0f} Hz; "
+        f"pooled over {part.get('rounds', '?')} rounds",
     )
+
+
+if __name__ == "__main__":
+    _role, _path, _port = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    if (_role, _path) not in _ROLES:
+        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, iceoryx2; found {sys.argv[1:3]}",
+              file=sys.stderr)
+        sys.exit(2)
+    from .. import run as _aiorun
+
+    _aiorun(_ROLES[(_role, _path)](_port))

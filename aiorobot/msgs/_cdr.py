@@ -35,7 +35,7 @@ class SerializationError(TypeError, ValueError):
 
 
 _SER: dict[type, Callable[[Any], bytes]] = {}
-_DES: dict[tuple[type, str], Callable[[Any, int], tuple[Any, int]]] = {}
+_DES: dict[tuple[type, str, bool], Callable[[Any, int], tuple[Any, int]]] = {}
 _SER_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError, Bad)
 _DES_ERRORS = (struct.error, ValueError, IndexError, OverflowError, MemoryError, TypeError, Bad)
 
@@ -119,12 +119,15 @@ def _check_primitive(typ: str, value: Any) -> str | None:
     return None
 
 
-def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str) -> Any:
+def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str, *, view: bool = False) -> Any:
     """Decode CDR ``data`` (with its 4-byte encapsulation header) as ``msg_type``.
 
     ``msg_type`` is a message class or a name like ``"geometry_msgs/msg/Twist"``.
     Little- and big-endian CDR are accepted, as are up to 3 trailing padding bytes.
     Raises DeserializationError (a ValueError) naming the type, field and offset.
+    ``view=True``: numeric array fields of little-endian data are numpy views into ``data`` instead
+    of copies (read-only when ``data`` is ``bytes``); ``data`` must then not change while the message
+    is in use.
     """
     cls = msg_type if isinstance(msg_type, type) else get(msg_type)
     if not (isinstance(cls, type) and issubclass(cls, Message)):
@@ -139,11 +142,11 @@ def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str) -> A
             f"cannot deserialize {cls.__msgtype__}: unsupported CDR encapsulation header "
             f"{bytes(data[:4]).hex(' ')}; expected 00 01 (CDR little endian) or 00 00 (big endian)")
     endian = "<" if data[1] == 1 else ">"
-    fn = _DES.get((cls, endian))
+    fn = _DES.get((cls, endian, view))
     if fn is None:
         from ._cdr_gen import build_deserializer
 
-        fn = _DES[(cls, endian)] = build_deserializer(cls, endian)
+        fn = _DES[(cls, endian, view)] = build_deserializer(cls, endian, view)
     try:
         obj, end = fn(data, 4)
     except _DES_ERRORS as exc:

@@ -50,6 +50,7 @@ class _Gen:
             "_Bad": Bad, "_PAD": _PAD, "_frombuffer": np.frombuffer, "_arr": as_array,
             "_farr": as_fixed_array, "_U32": struct.Struct(endian + "I"),
         }
+        self.view = False  # deserializer: arrays as views into the input, not copies
         self.indent = 1
         self.counter = 0
         self.mod, self.rem = 8, 0  # position (from the payload start) % mod == rem
@@ -285,7 +286,7 @@ def _des_value(g: _Gen, t: FieldType, path: str) -> str:
         dt = g.const("_D", dtype_of(t.base).newbyteorder(g.endian))
         var = g.name("_x")
         if g.endian == "<" or size == 1:
-            copy = ".copy()"
+            copy = "" if g.view else ".copy()"
         else:  # big endian data: convert to native little-endian arrays
             copy = f".astype({g.const('_D', dtype_of(t.base))})"
         if t.kind == ARRAY:
@@ -371,9 +372,10 @@ def _des_string(g: _Gen, t: FieldType, path: str) -> str:
     return var
 
 
-def build_deserializer(cls: type, endian: str) -> Callable[[Any, int], tuple[Any, int]]:
+def build_deserializer(cls: type, endian: str, view: bool = False) -> Callable[[Any, int], tuple[Any, int]]:
     spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
     g = _Gen(endian, "des")
+    g.view = view
     g.emit("L = len(d)")
     value = _des_fields(g, spec, "")
     g.flush()

@@ -18,6 +18,9 @@ __all__ = [
     "Attachment",
     "TokenInfo",
     "WireError",
+    "attachment_gid",
+    "attachment_head",
+    "attachment_tail",
     "data_key",
     "dds_type",
     "demangle",
@@ -34,7 +37,7 @@ __all__ = [
 ]
 
 ATTACHMENT_SIZE = 33
-_ATTACHMENT = struct.Struct("<qqB")
+_HEAD = struct.Struct("<qq")
 _GID_SIZE = 16
 #: rmw_zenoh's default depth (an empty depth field means it); depth 0 is sent as it too.
 _DEFAULT_DEPTH = 42
@@ -228,19 +231,44 @@ class Attachment:
     gid: bytes
 
 
-def pack_attachment(sequence: int, timestamp_ns: int, gid: bytes) -> bytes:
-    """The 33 bytes every put, query and reply carries."""
+def attachment_tail(gid: bytes) -> bytes:
+    """The part of a publisher's attachments that never changes: the GID length and the GID.
+
+    ``attachment_head(seq, ts) + attachment_tail(gid) == pack_attachment(seq, ts, gid)``; a
+    publisher computes the tail once.
+    """
     if len(gid) != _GID_SIZE:
         raise ValueError(f"gid: expected {_GID_SIZE} bytes, found {len(gid)}")
-    return _ATTACHMENT.pack(sequence, timestamp_ns, _GID_SIZE) + gid
+    return bytes((_GID_SIZE,)) + gid
 
 
-def unpack_attachment(data: bytes | None) -> Attachment:
+def attachment_head(sequence: int, timestamp_ns: int) -> bytes:
+    """The per-message part of an attachment: sequence number and timestamp (16 bytes)."""
+    return _HEAD.pack(sequence, timestamp_ns)
+
+
+def pack_attachment(sequence: int, timestamp_ns: int, gid: bytes) -> bytes:
+    """The 33 bytes every put, query and reply carries."""
+    return attachment_head(sequence, timestamp_ns) + attachment_tail(gid)
+
+
+def _check_attachment(data: bytes | None) -> bytes:
     if data is None:
         raise WireError("attachment: expected 33 bytes, found none")
     if len(data) != ATTACHMENT_SIZE:
         raise WireError(f"attachment: expected {ATTACHMENT_SIZE} bytes, found {len(data)}")
-    seq, ts, size = _ATTACHMENT.unpack_from(data)
-    if size != _GID_SIZE:
-        raise WireError(f"attachment: expected a GID length of 16, found {size}")
+    if data[16] != _GID_SIZE:
+        raise WireError(f"attachment: expected a GID length of 16, found {data[16]}")
+    return data
+
+
+def unpack_attachment(data: bytes | None) -> Attachment:
+    data = _check_attachment(data)
+    seq, ts = _HEAD.unpack_from(data)
     return Attachment(seq, ts, bytes(data[17:]))
+
+
+def attachment_gid(data: bytes | None) -> bytes:
+    """The GID of an attachment, checked as :func:`unpack_attachment` checks it (for a receiver
+    that needs nothing else)."""
+    return bytes(_check_attachment(data)[17:])

@@ -2,13 +2,15 @@
 
 * A local publisher gets an rmw_zenoh liveliness token; its topic gets one zenoh
   publisher fed by a hidden *sender tap* on the bus, which serialises to CDR in the
-  publishing thread and puts with the 33-byte attachment. Same-process subscribers
-  keep zero-copy delivery: they never see the tap.
+  publishing thread and puts with the 33-byte attachment (only while a remote
+  subscriber matches). Same-process subscribers keep zero-copy delivery: they never
+  see the tap.
 * A local subscription gets a token; its topic gets one zenoh subscriber (an
-  advanced one with history for transient local). Samples are checked (key, type
-  hash, attachment, CDR) and deserialised on zenoh's thread, then handed to the
-  main loop with ``call_soon_threadsafe``, where an *injector* (a publisher standing
-  for the remote one) publishes them into the bus.
+  advanced one with history for transient local). zenoh's thread queues each sample
+  (one queue, arrival order) and wakes the main loop once per batch; there samples
+  are checked (key, type hash, attachment, CDR), decoded (arrays as views into the
+  payload) and published into the bus by an *injector* (a publisher standing for the
+  remote one), a topic's depth at most per loop turn.
 * Remote endpoints learnt from liveliness tokens join the bus as endpoints of their
   own (injectors for publishers, passive taps for subscriptions, remote servers and
   clients for services), so ``Runtime.graph``, ``count_subscribers``,
@@ -29,7 +31,7 @@ import logging
 import os
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -39,6 +41,9 @@ from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, Reliabilit
 from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
 from .._core._transport import Transport
+from ..msgs import DeserializationError as _DeserializationError
+from ..msgs import deserialize as _deserialize
+from ..msgs import serialize as _serialize
 from ._diagnose import NOTHING_LISTENS, host_port, why_unreachable
 from ._session_config import (
     SessionPlan,
@@ -52,6 +57,9 @@ from ._session_config import (
 )
 from ._wire import (
     WireError,
+    attachment_gid,
+    attachment_head,
+    attachment_tail,
     data_key,
     dds_type,
     endpoint_token,
@@ -87,6 +95,13 @@ SHM_MIN_CHECK = 1024  # smaller payloads are never in shared memory here: skip a
 DEFAULT_SOURCE = "the default session config"
 #: the "no zenoh router" warning is given once a process
 _router_warned = threading.Event()
+#: received samples the transport holds for the main loop at most (a loop that stalled for longer than
+#: this many messages loses the oldest, counted as ``backlog`` drops); KEEP_LAST subscriptions keep their depth
+BACKLOG_LIMIT = 10_000
+#: samples of one topic the main loop injects before it lets the subscriptions' dispatchers run
+#: (fewer when the topic's smallest depth is smaller), and of all topics together
+MAX_CHUNK = 64
+MAX_DRAIN = 256
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
 
@@ -216,7 +231,12 @@ class _LocalNode:
 
 
 class _Outbound:
-    """One topic's zenoh publisher, fed by a hidden tap on the bus."""
+    """One topic's zenoh publisher, fed by a hidden tap on the bus.
+
+    Everything a put needs that does not change per message (key, attachment tail with the
+    GID, QoS, the shared-memory threshold) is settled here once; :meth:`_send` only
+    serialises, stamps and puts.
+    """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
         self.transport = transport
@@ -224,14 +244,18 @@ class _Outbound:
         self.msg_type = msg_type
         self.key = data_key(transport.domain_id, topic, msg_type.__msgtype__, type_hash)
         self.publishers: list[Publisher[Any]] = []
-        self.gid = b"\0" * 16
-        self.seq = 0
+        self._tail = attachment_tail(b"\0" * 16)
+        self._seq = itertools.count(1)
         self.zpub: Any = None
         self.advanced = False
+        self.matched = False  # a remote subscriber matches the key (kept by zenoh's matching listener)
         self.depth = 0
-        self.lock = threading.Lock()
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>")
         self.tap.hidden = True  # type: ignore[attr-defined]
+
+    def set_gid(self, gid: bytes) -> None:
+        """The GID every put's attachment carries (that of the topic's first local publisher)."""
+        self._tail = attachment_tail(gid)
 
     def declare(self, qos: QoSProfile) -> None:
         """(Re)declare the zenoh publisher so it serves ``qos`` (a cache for transient local)."""
@@ -256,6 +280,7 @@ class _Outbound:
         old = self.zpub
         if want_cache or self.advanced:
             self.depth = max(depth, self.depth)
+            self.matched = True
             self.zpub = zenoh.ext.declare_advanced_publisher(
                 session,
                 self.key,
@@ -269,29 +294,35 @@ class _Outbound:
             self.advanced = True
         else:
             self.depth = max(depth, self.depth)
-            self.zpub = session.declare_publisher(self.key, **kwargs)
+            zpub = session.declare_publisher(self.key, **kwargs)
+            # no remote subscriber matches: nothing to serialise (zenoh would drop the put); an
+            # advanced publisher's cache needs every message, so it has no listener
+            zpub.declare_matching_listener(self._on_matching)
+            self.matched = zpub.matching_status.matching
+            self.zpub = zpub
         if old is not None:
             old.undeclare()
+
+    def _on_matching(self, status: Any) -> None:
+        if not self.advanced:
+            self.matched = status.matching
 
     def _send(self, msg: Any) -> None:
         """The tap's callback: runs in the publishing thread."""
         transport = self.transport
-        if getattr(transport._local, "injecting", False):
-            return  # it came from the network: do not echo it back
-        from ..msgs import serialize
-
+        zpub = self.zpub
+        if zpub is None or getattr(transport._local, "injecting", False):
+            return  # closed, or it came from the network: do not echo it back
+        if not self.matched and not zpub.matching_status.matching:
+            return  # no remote subscriber (asked, as the listener's word may still be on its way)
         try:
-            data = serialize(msg)
+            data = _serialize(msg)
         except (TypeError, ValueError) as err:
             transport._warn("serialize", f"cannot send a message on {self.topic}: {err}")
             return
-        with self.lock:
-            self.seq += 1
-            attachment = pack_attachment(self.seq, time.time_ns(), self.gid)
-            zpub = self.zpub
-        if zpub is not None:
-            zpub.put(transport._payload(data), attachment=attachment)
-            transport._sent += 1
+        attachment = attachment_head(next(self._seq), time.time_ns()) + self._tail
+        zpub.put(data if len(data) < transport._shm_from else transport._payload(data), attachment=attachment)
+        transport._sent += 1
 
     def close(self) -> None:
         if self.zpub is not None:
@@ -300,7 +331,12 @@ class _Outbound:
 
 
 class _Inbound:
-    """One topic's zenoh subscriber; hands checked, decoded messages to the bus."""
+    """One topic's zenoh subscriber; hands checked, decoded messages to the bus.
+
+    zenoh's thread only queues a sample in the transport's one queue (all topics, in
+    arrival order); :meth:`ZenohTransport._drain` checks, decodes and injects them on the
+    main loop.
+    """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
         self.transport = transport
@@ -308,11 +344,27 @@ class _Inbound:
         self.msg_type = msg_type
         self.type_hash = type_hash
         self.prefix = f"{transport.domain_id}/{topic.strip('/')}/{dds_type(msg_type.__msgtype__)}"
+        self.key = f"{self.prefix}/{type_hash}"
         self.subscriptions: list[Subscription[Any]] = []
         self.zsub: Any = None
         self.advanced = False
         self.depth = 0
+        self.chunk = MAX_CHUNK
         self.fallback = _Injector(transport._owner, msg_type, topic, _FALLBACK_QOS, "<zenoh>", hidden=True)
+        self._injector: _Injector | None = None  # the injector of the last sample's GID
+        self._gid = b""
+
+    def add(self, sub: Any) -> None:
+        self.subscriptions.append(sub)
+        self._rechunk()
+
+    def remove(self, sub: Any) -> None:
+        self.subscriptions.remove(sub)
+        self._rechunk()
+
+    def _rechunk(self) -> None:
+        depths = [s.qos.depth for s in self.subscriptions if s.qos.history is HistoryPolicy.KEEP_LAST]
+        self.chunk = max(1, min([MAX_CHUNK, *depths]))
 
     def declare(self, qos: QoSProfile) -> None:
         import zenoh
@@ -344,35 +396,54 @@ class _Inbound:
             old.undeclare()
 
     def _on_sample(self, sample: Any) -> None:
-        """On a zenoh thread: check and decode, then hand over to the main loop."""
-        transport = self.transport
-        from ..msgs import DeserializationError, deserialize
+        """On a zenoh thread: queue the sample for the main loop."""
+        self.transport._queue(self, sample)
 
+    def _decode(self, sample: Any) -> tuple[bytes, Any] | None:
+        """Check a sample (key, attachment, CDR) and decode it: ``(gid, message)``, or None when dropped."""
+        transport = self.transport
         key = str(sample.key_expr)
         try:
-            found_hash = key[len(self.prefix) + 1 :]
-            if found_hash != self.type_hash:
+            if key != self.key:
+                found_hash = key[len(self.prefix) + 1 :]
                 raise WireError(
                     f"type hash on {self.topic}: expected {self.type_hash} for {self.msg_type.__msgtype__}, "
                     f"found {found_hash or 'none'}; the two sides use different definitions"
                 )
             raw = sample.attachment
-            attachment = unpack_attachment(None if raw is None else raw.to_bytes())
+            gid = attachment_gid(None if raw is None else raw.to_bytes())
             payload = sample.payload
-            msg = deserialize(payload.to_bytes(), self.msg_type)
-            if len(payload) >= SHM_MIN_CHECK and payload.as_shm() is not None:
+            data = payload.to_bytes()
+            msg = _deserialize(data, self.msg_type, view=True)  # arrays: read-only views into the bytes
+            if len(data) >= SHM_MIN_CHECK and payload.as_shm() is not None:
                 transport._received_shm += 1
         except WireError as err:
             transport._warn("wire", f"dropped a sample on {key}: {err}")
-            return
-        except DeserializationError as err:
+            return None
+        except _DeserializationError as err:
             transport._warn("cdr", f"dropped a sample on {key}: malformed CDR: {err}")
-            return
+            return None
         except Exception as err:  # noqa: BLE001 - nothing from the network may escape
             transport._warn("other", f"dropped a sample on {key}: {type(err).__name__}: {err}")
-            return
+            return None
         transport._received += 1
-        transport._to_loop(transport._inject, self, attachment.gid, msg)
+        return gid, msg
+
+    def _inject(self, gid: bytes, msg: Any) -> None:
+        """On the main loop: publish a received message into the bus as its remote publisher."""
+        injector = self._injector
+        if gid != self._gid or injector is None or injector.destroyed:
+            injector = self.transport._by_gid.get(gid)
+            if injector is None or injector.topic_name != self.topic or injector.msg_type is not self.msg_type:
+                injector = self.fallback  # not remembered: the publisher's own injector may arrive later
+            else:
+                self._gid, self._injector = gid, injector
+        if injector.destroyed:
+            return
+        try:
+            injector.publish(msg)
+        except Exception as err:  # noqa: BLE001
+            self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
 
     def close(self) -> None:
         if self.zsub is not None:
@@ -391,7 +462,7 @@ class ZenohTransport(Transport):
         A zenoh JSON5 config file used as is (routers, TLS/mTLS, access control).
         Without one: peer mode, listen on ``tcp/127.0.0.1:0``, connect to a router
         on ``tcp/127.0.0.1:7447``, multicast scouting off (rmw_zenoh's defaults, on
-        loopback), and zenoh's transmit batching off (latency before throughput). ``ZENOH_SESSION_CONFIG_URI`` names a file too, and
+        loopback). ``ZENOH_SESSION_CONFIG_URI`` names a file too, and
         ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``) applies last, as in rmw_zenoh.
     connect, listen
         Endpoints replacing the defaults.
@@ -454,12 +525,16 @@ class ZenohTransport(Transport):
         self._last_warning: dict[str, float] = {}
         self._hashes: dict[Any, str] = {}
         self._shm: Any = None  # zenoh.shm.ShmProvider when the session has shared memory enabled
-        #: messages of this many bytes or more (CDR) go through shared memory, when it is enabled
-        self.shm_threshold = SHM_THRESHOLD
+        self._shm_threshold = SHM_THRESHOLD
+        self._shm_from = float("inf")  # the threshold while a pool is open, else never
         self._sent_shm = 0
         self._received_shm = 0
         self._drops_shm_full = 0  # sends that fell back to the network because the pool was full
         self._shm_lock = threading.Lock()
+        # received samples on their way to the main loop: (inbound, sample), in arrival order
+        self._pending: deque[tuple[_Inbound, Any]] = deque()
+        self._armed = False  # a drain is due on the loop
+        self._arming = threading.Lock()
 
     def __repr__(self) -> str:
         state = f"zid={self._zid}" if self._session is not None else "closed"
@@ -548,6 +623,7 @@ class ZenohTransport(Transport):
                 token.undeclare()
             self._outbound.clear()
             self._inbound.clear()
+            self._pending.clear()
             self._queryables.clear()
             self._tokens.clear()
             self._nodes.clear()
@@ -586,8 +662,20 @@ class ZenohTransport(Transport):
             from zenoh.shm import ShmProvider
 
             self._shm = ShmProvider.default_backend(size)
+            self._shm_from = self._shm_threshold
         except Exception as err:  # noqa: BLE001 - no /dev/shm, a platform without it: use the network
             _log.warning(f"zenoh shared memory is enabled but a {size}-byte pool could not be made ({err}); large messages go over the network")
+
+    @property
+    def shm_threshold(self) -> int:
+        """Messages of this many bytes or more (CDR) go through shared memory, when it is enabled."""
+        return self._shm_threshold
+
+    @shm_threshold.setter
+    def shm_threshold(self, value: int) -> None:
+        self._shm_threshold = value
+        if self._shm is not None:
+            self._shm_from = value
 
     def _payload(self, data: bytes) -> Any:
         """``data`` as zenoh should send it: in a shared-memory buffer when it is large enough."""
@@ -618,6 +706,59 @@ class ZenohTransport(Transport):
     def _to_loop(self, fn: Any, *args: Any) -> None:
         if self._loop is not None:
             post(self._loop, fn, *args)
+
+    def _queue(self, inbound: _Inbound, sample: Any) -> None:
+        """On a zenoh thread: queue a received sample; wake the loop unless a drain is already due
+        (one ``call_soon_threadsafe`` per batch of samples that arrive together)."""
+        pending = self._pending
+        if len(pending) >= BACKLOG_LIMIT:
+            lost, _ = pending.popleft()
+            self._warn(
+                "backlog", f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
+            )
+        pending.append((inbound, sample))
+        if not self._armed:
+            with self._arming:
+                if self._armed:
+                    return
+                self._armed = True
+            self._to_loop(self._drain)
+
+    def _drain(self) -> None:
+        """On the main loop: decode and inject queued samples in arrival order, at most ``chunk`` of
+        one topic (its smallest subscription depth) before the dispatchers run; then the next drain.
+        One drain is due at a time; samples that pile up while the process is descheduled so never
+        fill a subscription queue past its depth, and topics keep their relative order."""
+        pending = self._pending
+        local = self._local
+        taken: dict[int, int] = {}
+        local.injecting = True
+        try:
+            for _ in range(MAX_DRAIN):
+                try:
+                    inbound, sample = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
+                except IndexError:
+                    break
+                n = taken.get(id(inbound), 0)
+                if n >= inbound.chunk:
+                    pending.appendleft(item)  # the topic's dispatchers run first
+                    break
+                taken[id(inbound)] = n + 1
+                if inbound.zsub is None:
+                    continue  # the topic's last subscription left meanwhile
+                decoded = inbound._decode(sample)
+                if decoded is not None:
+                    inbound._inject(*decoded)
+        finally:
+            local.injecting = False
+        loop = self._loop
+        if not pending or loop is None or loop.is_closed():
+            with self._arming:
+                self._armed = False
+                if not pending or loop is None or loop.is_closed():
+                    return
+                self._armed = True  # a sample came in between: it would wait for the next one
+        loop.call_soon(self._drain)
 
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)
@@ -700,7 +841,7 @@ class ZenohTransport(Transport):
             elif isinstance(endpoint, (Subscription, Tap)):
                 inb = self._inbound.get((endpoint.topic_name, endpoint.type_name))
                 if inb is not None and endpoint in inb.subscriptions:
-                    inb.subscriptions.remove(endpoint)
+                    inb.remove(endpoint)
                     if not inb.subscriptions:
                         del self._inbound[(inb.topic, endpoint.type_name)]
                         if self.bus is not None:
@@ -719,7 +860,7 @@ class ZenohTransport(Transport):
         new = out is None
         if out is None:
             out = self._outbound[key] = _Outbound(self, pub.topic_name, pub.msg_type, type_hash)
-            out.gid = gid_of(token)
+            out.set_gid(gid_of(token))
         out.declare(pub.qos)
         out.publishers.append(pub)
         if new and self.bus is not None:
@@ -732,7 +873,7 @@ class ZenohTransport(Transport):
         new = inb is None
         if inb is None:
             inb = self._inbound[key] = _Inbound(self, sub.topic_name, sub.msg_type, type_hash)
-        inb.subscriptions.append(sub)
+        inb.add(sub)
         if new and self.bus is not None:
             self.bus.add_publisher(inb.fallback)
         inb.declare(sub.qos)
@@ -740,21 +881,6 @@ class ZenohTransport(Transport):
         # token, and so counts the subscription as matched, finds the route to it already declared.
         if sub.node is not None:  # the runtime's /clock tap has no node: it receives without a graph entry
             self._declare_endpoint(sub, "MS", sub.topic_name, sub.type_name, type_hash, sub.qos)
-
-    def _inject(self, inbound: _Inbound, gid: bytes, msg: Any) -> None:
-        """On the main loop: publish a received message into the bus as its remote publisher."""
-        injector = self._by_gid.get(gid)
-        if injector is None or injector.topic_name != inbound.topic or injector.msg_type is not inbound.msg_type:
-            injector = inbound.fallback
-        if injector.destroyed:
-            return
-        self._local.injecting = True
-        try:
-            injector.publish(msg)
-        except Exception as err:  # noqa: BLE001
-            self._warn("inject", f"could not deliver a message on {inbound.topic}: {err}")
-        finally:
-            self._local.injecting = False
 
     # -- services --------------------------------------------------------------------------
 
@@ -1086,10 +1212,9 @@ def build_session_config(
         cfg.insert_json5("scouting/multicast/enabled", "false")
         cfg.insert_json5("listen/endpoints", json.dumps(listen or [DEFAULT_LISTEN]))
         cfg.insert_json5("connect/endpoints", json.dumps(connect if connect is not None else [DEFAULT_CONNECT]))
-        # zenoh's lazy batching holds a small message up to batching/time_limit (1 ms) and, at a
-        # steady 1-2 kHz, for several: 3-5 ms one-way on loopback instead of ~0.2 ms. A robot's
-        # graph wants latency; a config file (or ZENOH_CONFIG_OVERRIDE) can turn it back on.
-        cfg.insert_json5("transport/link/tx/queue/batching/enabled", "false")
+        # zenoh's transmit batching stays on (its default and rmw_zenoh's): it batches only under
+        # back-pressure, so a steady stream is not held back, and a stall of the transmit thread
+        # fills a batch instead of two one-message slots that then drop (docs/zenoh.md)
         # Large messages (images, clouds) to peers on this host go through shared memory;
         # zenoh falls back to the network for a peer that cannot map it.
         cfg.insert_json5("transport/shared_memory/enabled", "true")
