@@ -20,9 +20,37 @@ import sys
 import time
 from typing import Any
 
-from ._zenoh import _report, _send_images, _stats
+from ._zenoh import _stats
 
 __all__ = ["run", "table"]
+
+
+async def _send_images(image: Any, n: int) -> None:
+    """Publish ``n`` sender-stamped 640x480x3 images, 10 ms apart, then let the last ones land."""
+    import numpy as np
+
+    from ..msgs.sensor_msgs import Image
+
+    data = np.zeros(640 * 480 * 3, dtype=np.uint8)
+    for _ in range(n):
+        now = time.monotonic_ns()
+        msg = Image(height=480, width=640, encoding="rgb8", step=640 * 3, data=data)
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(now, 1_000_000_000)
+        image.publish(msg)
+        await asyncio.sleep(0.01)
+    await asyncio.sleep(0.3)
+
+
+async def _report(child: subprocess.Popen[str]) -> dict[str, Any]:
+    """Ask the receiving child for its figures (one JSON line)."""
+    import json
+
+    assert child.stdin is not None and child.stdout is not None
+    child.stdin.write("report\n")
+    child.stdin.flush()
+    line = await asyncio.to_thread(child.stdout.readline)
+    return json.loads(line)
+
 
 def _domain() -> int:
     """The domain the two processes meet in: ROS's 215..232 range (rarely used by robots), by pid."""

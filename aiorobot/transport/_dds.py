@@ -574,8 +574,23 @@ class DdsTransport(Transport):
     _warn = ZenohTransport._warn
     _to_loop = ZenohTransport._to_loop
     _hash = ZenohTransport._hash
-    _inject = ZenohTransport._inject
     _add_to_bus = ZenohTransport._add_to_bus
+
+    def _inject(self, inbound: Any, gid: Any, msg: Any) -> None:
+        """On the main loop: publish a received message into the bus as its remote publisher (the
+        writer's own injector when its graph entry is known, else the topic's fallback)."""
+        injector = self._by_gid.get(gid)
+        if injector is None or injector.topic_name != inbound.topic or injector.msg_type is not inbound.msg_type:
+            injector = inbound.fallback
+        if injector.destroyed:
+            return
+        self._local.injecting = True
+        try:
+            injector.publish(msg)
+        except Exception as err:  # noqa: BLE001
+            self._warn("inject", f"could not deliver a message on {inbound.topic}: {err}")
+        finally:
+            self._local.injecting = False
 
     def _endpoint_id(self) -> str:
         """rmw_cyclonedds's ``clientid``/``serviceid``: the participant GUID prefix and a counter, as
