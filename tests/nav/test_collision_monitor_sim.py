@@ -94,11 +94,17 @@ class Pusher(Node):
             self.stopped_at = self.sim.time_ns / 1e9
 
 
-async def _run(seed: int) -> tuple[Simulator, Pusher, CollisionMonitorNode]:
+#: MPPI with its obstacle critic off: like RPP's collision check off, only the monitor can stop the robot
+BLIND_MPPI = {"controller": "mppi", "critics": ["ConstraintCritic", "GoalCritic", "GoalAngleCritic", "PathAlignCritic",
+                                                 "PathFollowCritic", "PathAngleCritic", "PreferForwardCritic"]}
+
+
+async def _run(seed: int, controller: str = "rpp") -> tuple[Simulator, Pusher, CollisionMonitorNode]:
     async with Runtime(use_sim_time=True, handle_signals=False) as rt:
         sim = simulator(seed)
+        chosen = BLIND_MPPI if controller == "mppi" else {}
         rt.add_node(NavigationServer(parameter_overrides={"use_collision_detection": False, "replan_period": 30.0,
-                                                          "desired_linear_vel": 0.5,
+                                                          "desired_linear_vel": 0.5, **chosen,
                                                           "localization_topic": ""},
                                      remappings={"/cmd_vel": "/cmd_vel_nav"}))
         monitor = rt.add_node(CollisionMonitorNode(parameter_overrides=monitor_parameters()), executor="priority")
@@ -115,9 +121,11 @@ async def _run(seed: int) -> tuple[Simulator, Pusher, CollisionMonitorNode]:
     return sim, pusher, monitor
 
 
-@pytest.mark.parametrize("seed", [1, 2])
-async def test_a_box_pushed_1_m_ahead_stops_the_robot_before_contact_whatever_rpp_commands(seed: int) -> None:
-    sim, pusher, monitor = await _run(seed)
+@pytest.mark.parametrize(("seed", "controller"), [(1, "rpp"), (2, "rpp"), (3, "mppi")])
+async def test_a_box_pushed_1_m_ahead_stops_the_robot_before_contact_whatever_the_controller_commands(
+    seed: int, controller: str
+) -> None:
+    sim, pusher, monitor = await _run(seed, controller)
     assert pusher.box_x is not None
     assert sim.body.collisions == 0
     assert pusher.stopped_gap is not None and pusher.stopped_gap > 0.02, pusher.stopped_gap
