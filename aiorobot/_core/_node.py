@@ -724,19 +724,6 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         recorder.add(end - start_ns)
         self._last_callback = (start_ns, end, entity)
 
-    async def _timed_call(self, entity: Any, fn: Callable[..., Any], args: tuple[Any, ...], start_deadline: int | None) -> Any:
-        """``fn(*args)``, awaited if it returns an awaitable, its duration counted against ``entity``."""
-        if start_deadline is not None:
-            entity._record_start(start_deadline)
-        start = time.monotonic_ns()
-        try:
-            result = fn(*args)
-            if result is not None and inspect.isawaitable(result):
-                return await result
-            return result
-        finally:
-            self._record_callback(entity, start)
-
     async def _invoke(
         self,
         entity: Any,
@@ -745,12 +732,31 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         *args: Any,
         start_deadline: int | None = None,
     ) -> Any:
-        """Run one callback under its group; log (never raise) what it raises."""
+        """Run one callback under its group, its duration counted against ``entity``; log (never
+        raise) what it raises. One coroutine per callback: this is every message's and tick's path."""
         try:
             if group.exclusive:
                 async with group:
-                    return await self._timed_call(entity, fn, args, start_deadline)
-            return await self._timed_call(entity, fn, args, start_deadline)
+                    if start_deadline is not None:
+                        entity._record_start(start_deadline)
+                    start = time.monotonic_ns()
+                    try:
+                        result = fn(*args)
+                        if result is not None and inspect.isawaitable(result):
+                            result = await result
+                    finally:
+                        self._record_callback(entity, start)
+                    return result
+            if start_deadline is not None:
+                entity._record_start(start_deadline)
+            start = time.monotonic_ns()
+            try:
+                result = fn(*args)
+                if result is not None and inspect.isawaitable(result):
+                    result = await result
+            finally:
+                self._record_callback(entity, start)
+            return result
         except asyncio.CancelledError:
             raise
         except Exception as err:
