@@ -48,7 +48,11 @@ ROSOUT_QOS = QoSProfile(
 )
 
 #: set while a thread publishes a /rosout line: what that publish logs is not published again
-_in_rosout = threading.local()
+class _RosoutGuard(threading.local):
+    active = False  # a class default: reading it never raises (an AttributeError is slow)
+
+
+_in_rosout = _RosoutGuard()
 
 LEVELS = {
     "debug": logging.DEBUG,
@@ -195,7 +199,7 @@ class NodeLogger:
     ) -> None:
         """One ``rcl_interfaces/msg/Log`` on ``/rosout``; a failure here is never the caller's."""
         pub = self._rosout
-        if pub is None or pub.destroyed or getattr(_in_rosout, "active", False):
+        if pub is None or pub.destroyed or _in_rosout.active:
             return
         _in_rosout.active = True
         try:

@@ -115,6 +115,7 @@ class Publisher(Endpoint, Generic[M]):
         self._own_loop: asyncio.AbstractEventLoop | None = None
         self._other_loops: tuple[tuple[asyncio.AbstractEventLoop, tuple[Subscription, ...]], ...] = ()
         self._taps: tuple[Tap, ...] = ()
+        self._keepers = False  # a receiver keeps what is published: it gets a copy (see _accept)
         self._thread_id: int | None = None
         self._guard: PublishGuard | None = None  # Runtime(debug_messages=True)
         self._freeze = getattr(msg_type, "_cp", None)  # generated message classes only
@@ -190,6 +191,7 @@ class Publisher(Endpoint, Generic[M]):
             elif loop is not None:
                 other.setdefault(loop, []).append(sub)
         self._subs = subs
+        self._keepers = bool(same or other or any(tap.keeps for tap in taps))
         self._same_loop = tuple(same)
         self._other_loops = tuple((loop, tuple(group)) for loop, group in other.items())
         self._taps = tuple(taps)
@@ -260,7 +262,7 @@ class Publisher(Endpoint, Generic[M]):
         if self.destroyed:
             raise RuntimeError(f"{self!r} was destroyed")
         self.published += 1
-        if self._freeze is not None and (self._subs or self._history is not None):
+        if self._freeze is not None and (self._keepers or self._history is not None):
             msg = self._freeze(msg, self._frozen_classes)
         if self._guard is not None and not self._guard.check(msg):
             self.node.get_logger().error(
@@ -361,10 +363,23 @@ class Tap(Endpoint):
 
     kind = "subscription"
 
-    def __init__(self, msg_type: Any, topic: str, qos: QoSProfile, callback: Callable[[Any], None], *, owner: str = "<runtime>") -> None:
+    def __init__(
+        self,
+        msg_type: Any,
+        topic: str,
+        qos: QoSProfile,
+        callback: Callable[[Any], None],
+        *,
+        owner: str = "<runtime>",
+        keeps: bool = True,
+    ) -> None:
         super().__init__(None, msg_type, topic, qos)
         self._enqueue = callback
         self.owner = owner
+        #: The callback may keep the message past its return (a recorder's queue). False for a
+        #: transport's outbound tap, which serialises it at once: a publisher whose only
+        #: receivers are such taps makes no copy.
+        self.keeps = keeps
 
     @property
     def node_name(self) -> str:

@@ -125,9 +125,10 @@ def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str, *, v
     ``msg_type`` is a message class or a name like ``"geometry_msgs/msg/Twist"``.
     Little- and big-endian CDR are accepted, as are up to 3 trailing padding bytes.
     Raises DeserializationError (a ValueError) naming the type, field and offset.
-    ``view=True``: numeric array fields of little-endian data are numpy views into ``data`` instead
-    of copies (read-only when ``data`` is ``bytes``); ``data`` must then not change while the message
-    is in use.
+    ``view=True``: the message in the form subscribers get it: numeric array fields of
+    little-endian data are numpy views into ``data`` instead of copies (read-only when ``data`` is
+    ``bytes``; ``data`` must then not change while the message is in use), arrays converted from
+    big-endian data are read-only too, and sequences of strings and messages are read-only lists.
     """
     cls = msg_type if isinstance(msg_type, type) else get(msg_type)
     if not (isinstance(cls, type) and issubclass(cls, Message)):

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ._cdr import Bad
-from ._classgen import as_array, as_fixed_array, dtype_of
+from ._classgen import FrozenList, as_array, as_fixed_array, dtype_of
 from ._registry import get
 from ._spec import ARRAY, PRIMITIVES, SCALAR, SEQUENCE, FieldType, MsgSpec
 
@@ -297,6 +297,7 @@ def _des_value(g: _Gen, t: FieldType, path: str) -> str:
             g.emit(f"if {nbytes} > L - p: raise _Bad('needs {nbytes} bytes, %d left' % (L - p))",
                    ctx)
             g.emit(f"{var} = _frombuffer(d, {dt}, {t.count}, p){copy}", ctx)
+            _read_only(g, var, copy)
             g.emit(f"p += {nbytes}")
             g.advance(nbytes)
             return var
@@ -310,6 +311,7 @@ def _des_value(g: _Gen, t: FieldType, path: str) -> str:
         g.emit(f"if {count} * {size} > L - p: raise _Bad('sequence of %d {t.base} needs %d "
                f"bytes, %d left' % ({count}, {count} * {size}, L - p))", ctx)
         g.emit(f"{var} = _frombuffer(d, {dt}, {count}, p){copy}", ctx)
+        _read_only(g, var, copy)
         g.emit(f"p += {count} * {size}")
         g.unknown(min(size, 4))
         return var
@@ -336,7 +338,17 @@ def _des_value(g: _Gen, t: FieldType, path: str) -> str:
     g.emit(f"{seq}.append({value})")
     g.indent -= 1
     g.unknown()
+    if g.view:  # the message as subscribers get it: its sequences read-only
+        g.ns["_FL"] = FrozenList
+        g.emit(f"{seq} = _FL({seq})")
     return seq
+
+
+def _read_only(g: _Gen, var: str, copy: str) -> None:
+    """In view mode an array converted from big-endian data is a new, writable array: make it
+    read-only like the views (a message decoded with ``view=True`` is in its delivered form)."""
+    if g.view and copy.startswith(".astype"):
+        g.emit(f"{var}.flags.writeable = False")
 
 
 def _des_bound(g: _Gen, t: FieldType, count: str, path: str) -> None:

@@ -51,7 +51,7 @@ from ._dds_wire import (
     topic_name,
     user_data,
 )
-from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer
+from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer, _ThreadFlags
 
 if TYPE_CHECKING:
     from .._core._bus import Bus
@@ -187,7 +187,7 @@ class _Outbound:
         self.publishers: list[Publisher[Any]] = []
         self.qos: QoSProfile | None = None
         self.writer: Any = None
-        self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<dds>")
+        self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<dds>", keeps=False)
         self.tap.hidden = True  # type: ignore[attr-defined]
 
     def declare(self, qos: QoSProfile) -> None:
@@ -208,7 +208,7 @@ class _Outbound:
     def _send(self, msg: Any) -> None:
         """The tap's callback: runs in the publishing thread."""
         transport = self.transport
-        if getattr(transport._local, "injecting", False):
+        if transport._local.injecting:
             return  # it came from the network: do not echo it back
         from cyclonedds._clayer import ddspy_write
 
@@ -421,7 +421,7 @@ class DdsTransport(Transport):
         self._loop: asyncio.AbstractEventLoop | None = None
         self._owner: _Owner = None  # type: ignore[assignment]
         self._lock = threading.RLock()
-        self._local = threading.local()
+        self._local = _ThreadFlags()
         self._ids = itertools.count(1)
         self._topics: dict[tuple[str, str], Any] = {}
         self._outbound: dict[tuple[str, str], _Outbound] = {}
@@ -793,7 +793,7 @@ class DdsTransport(Transport):
             self._handle_of[guid] = handle
             self._add_to_bus(injector)
         elif parsed.kind == "topic":
-            tap = Tap(cls, parsed.name, qos, _ignore, owner=node)
+            tap = Tap(cls, parsed.name, qos, _ignore, owner=node, keeps=False)
             self._remote[guid] = tap
             self._add_to_bus(tap)
         elif parsed.kind == "request" and kind == "reader":

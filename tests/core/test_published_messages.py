@@ -63,6 +63,60 @@ async def test_subscribers_of_one_publish_share_one_copy_with_read_only_arrays_a
     assert list(msg.name) == ["elbow"] and msg.position[0] == 0.5 and msg.header.frame_id == ""
 
 
+async def test_a_tap_that_keeps_nothing_gets_the_publishers_object_and_one_that_keeps_gets_the_copy(runtime):
+    """A transport's outbound tap serialises at once: a publisher whose only receivers are such
+    taps makes no copy; a tap that may keep the message (a recorder) gets the shared copy."""
+    from aiorobot import QoSProfile, lowlevel
+
+    node = runtime.add_node(Node("talker"))
+    pub = node.create_publisher(JointState, "/joints", 10)
+    passing, kept = [], []
+    passer = lowlevel.Tap(JointState, "/joints", QoSProfile(depth=10), passing.append, owner="<wire>", keeps=False)
+    lowlevel.add_tap(runtime, passer)
+    sent = JointState(name=["elbow"], position=[0.5])
+    pub.publish(sent)
+    assert passing == [sent] and passing[0] is sent
+    keeper = lowlevel.Tap(JointState, "/joints", QoSProfile(depth=10), kept.append, owner="<recorder>")
+    lowlevel.add_tap(runtime, keeper)
+    pub.publish(sent)
+    assert kept[0] is not sent and kept[0] == sent and passing[1] is kept[0]  # one copy for all of them
+    with pytest.raises(ReadOnlyMessageError):
+        kept[0].name.append("wrist")
+
+
+def test_a_message_decoded_with_view_is_in_its_delivered_form():
+    """``deserialize(..., view=True)`` (what the zenoh transport decodes with) gives read-only
+    sequences and arrays, little- and big-endian alike, so nobody needs to copy it again."""
+    sent = JointState(name=["elbow"], position=[0.5], velocity=[0.25])
+    little = serialize(sent)
+    for data in (little, _big_endian_joint_state(sent)):
+        msg = deserialize(data, JointState, view=True)
+        assert msg == sent
+        with pytest.raises(ReadOnlyMessageError):
+            msg.name.append("wrist")
+        for array in (msg.position, msg.velocity):
+            assert not array.flags.writeable
+    plain = deserialize(little, JointState)  # the default: a message of one's own
+    plain.name.append("wrist")
+    plain.position[0] = 1.0
+
+
+def _big_endian_joint_state(msg):
+    """``msg`` (empty header, one name, float64 position and velocity, no effort) in big-endian CDR."""
+    import struct
+
+    name = msg.name[0].encode() + b"\0"
+    body = struct.pack(">iII", 0, 0, 1) + b"\0"  # stamp, frame_id "" (length 1, NUL)
+    body += b"\0" * 3 + struct.pack(">I", 1) + struct.pack(">I", len(name)) + name
+    body += b"\0" * (-(len(body)) % 4)
+    body += struct.pack(">I", 1)
+    body += b"\0" * (-(len(body)) % 8) + struct.pack(">d", msg.position[0])
+    body += struct.pack(">I", 1)
+    body += b"\0" * (-(len(body)) % 8) + struct.pack(">d", msg.velocity[0])
+    body += struct.pack(">I", 0)
+    return b"\0\0\0\0" + body
+
+
 async def test_with_debug_messages_every_field_is_read_only_and_names_the_topic():
     got = []
     async with Runtime(debug_messages=True, handle_signals=False) as rt:

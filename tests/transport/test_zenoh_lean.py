@@ -8,6 +8,7 @@ from collections.abc import AsyncIterator
 from typing import Any
 
 import numpy as np
+import pytest
 
 from aiorobot import Node, QoSProfile, ReliabilityPolicy, Runtime
 from aiorobot.msgs import deserialize, serialize
@@ -55,6 +56,19 @@ async def main(rt):
     reader = await stdin_lines()
     while (await reader.readline()).decode().strip() == "ping":
         pub.publish(Image(height=240, width=320, encoding="rgb8", step=960, data=pixels))
+        say("pinged")
+"""
+
+JOINTS = """
+from aiorobot.msgs.sensor_msgs import JointState
+async def main(rt):
+    node = Node("arm")
+    rt.add_node(node)
+    pub = node.create_publisher(JointState, "/joints", 5)
+    say("ready")
+    reader = await stdin_lines()
+    while (await reader.readline()).decode().strip() == "ping":
+        pub.publish(JointState(name=["shoulder", "elbow"], position=[0.5, 1.5]))
         say("pinged")
 """
 
@@ -133,6 +147,30 @@ async def test_a_received_image_is_a_read_only_view_into_the_payload(router_port
         assert np.array_equal(data, (np.arange(320 * 240 * 3) % 251).astype(np.uint8))
         assert not data.flags.writeable and not data.flags.owndata
         assert isinstance(_root(data), bytes)  # the payload's bytes, decoded in place
+
+
+async def test_a_received_message_is_in_the_form_a_local_publish_delivers(router_port: int) -> None:
+    """Decoded in place and handed over without the publish copy: its sequences and arrays are
+    read-only as a local publish makes them, and the subscriptions of one topic share it."""
+    from aiorobot.msgs import ReadOnlyMessageError
+    from aiorobot.msgs.sensor_msgs import JointState
+
+    async with _beside(JOINTS, router_port, "watcher") as (child, rt, node):
+        a: list[JointState] = []
+        b: list[JointState] = []
+        node.create_subscription(JointState, "/joints", a.append, 5)
+        node.create_subscription(JointState, "/joints", b.append, 5)
+        await _first_arrival(child, rt, "/joints", a)
+        await wait_until(lambda: bool(b))
+        msg = a[0]
+        assert b[0] is msg and list(msg.name) == ["shoulder", "elbow"] and list(msg.position) == [0.5, 1.5]
+        with pytest.raises(ReadOnlyMessageError):
+            msg.name.append("wrist")
+        with pytest.raises(ValueError, match="read-only"):
+            msg.position[0] = 2.0
+        mine = msg.copy()
+        mine.name.append("wrist")
+        assert list(msg.name) == ["shoulder", "elbow"]
 
 
 async def test_a_loop_stalled_past_the_backlog_limit_loses_the_oldest_and_says_so(
