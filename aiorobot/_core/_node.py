@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from ._actions import DEFAULT_RESULT_TIMEOUT_SEC, ActionClient, ActionServer
 from ._clock import Clock
-from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup
+from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from ._handoff import post
 from ._logging import ROSOUT_QOS, NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
@@ -735,33 +735,35 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         """Run one callback under its group, its duration counted against ``entity``; log (never
         raise) what it raises. One coroutine per callback: this is every message's and tick's path."""
         try:
-            if group.exclusive:
+            lock = group._group_lock
+            if lock is None and group.exclusive:  # a group class of one's own, with its own __aenter__
                 async with group:
-                    if start_deadline is not None:
-                        entity._record_start(start_deadline)
-                    start = time.monotonic_ns()
-                    try:
-                        result = fn(*args)
-                        if result is not None and inspect.isawaitable(result):
-                            result = await result
-                    finally:
-                        self._record_callback(entity, start)
-                    return result
-            if start_deadline is not None:
-                entity._record_start(start_deadline)
-            start = time.monotonic_ns()
+                    return await self._invoke(entity, _UNLOCKED, fn, *args, start_deadline=start_deadline)
+            if lock is not None and not lock.try_acquire():  # free: taken at once, no coroutine
+                await lock.acquire()
             try:
-                result = fn(*args)
-                if result is not None and inspect.isawaitable(result):
-                    result = await result
+                if start_deadline is not None:
+                    entity._record_start(start_deadline)
+                start = time.monotonic_ns()
+                try:
+                    result = fn(*args)
+                    if result is not None and inspect.isawaitable(result):
+                        result = await result
+                finally:
+                    self._record_callback(entity, start)
+                return result
             finally:
-                self._record_callback(entity, start)
-            return result
+                if lock is not None:
+                    lock.release()
         except asyncio.CancelledError:
             raise
         except Exception as err:
             self._report_failure(f"callback of {_describe(entity)}", err)
             return None
+
+
+#: What :meth:`Node._invoke` runs a callback of a lockless group's own class under, inside its ``async with``.
+_UNLOCKED = ReentrantCallbackGroup()
 
 
 def _discard_result(future: Any) -> None:
