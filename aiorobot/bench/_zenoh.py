@@ -4,9 +4,12 @@ developer could pick, each a pair of processes, interleaved in one run.
 Paths (each one a sender process and a receiver process of its own):
 
 - ``aiorobot``: a Runtime with a ZenohTransport in each process (a Twist, a 640x480x3 Image);
-- ``zenoh``: bare zenoh-python, the same session config (the transport's defaults: batching off,
+- ``zenoh``: bare zenoh-python, the same session config (``build_session_config``: batching on,
   shared memory on, through the same router), ``put`` -> callback; the image put from a
   ``ShmProvider`` buffer;
+- ``zenoh-loop``: the same bare pair, its receiver handing each sample to its asyncio (uvloop)
+  loop with ``call_soon_threadsafe`` and stamping it there: the floor of any asyncio receiver,
+  aiorobot's included;
 - ``iceoryx2``: iceoryx2 pub/sub with an event to wake the receiver, when ``iceoryx2`` is
   importable; the image written once into a loaned sample;
 - ``dora-rs`` is listed when importable but not measured (its nodes run under a dora daemon and
@@ -30,7 +33,7 @@ from typing import Any
 
 __all__ = ["PATHS", "available_paths", "run", "table"]
 
-PATHS = ("aiorobot", "zenoh", "iceoryx2", "dora-rs")
+PATHS = ("aiorobot", "zenoh", "zenoh-loop", "iceoryx2", "dora-rs")
 SMALL_BYTES = 52  # a Twist's CDR
 IMAGE_BYTES = 640 * 480 * 3
 SMALL_HZ = 1000.0
@@ -42,7 +45,7 @@ def available_paths() -> dict[str, str | None]:
     """Each path, and why it cannot run here (None: it can)."""
     import importlib.util
 
-    out: dict[str, str | None] = {"aiorobot": None, "zenoh": None}
+    out: dict[str, str | None] = {"aiorobot": None, "zenoh": None, "zenoh-loop": None}
     out["iceoryx2"] = None if importlib.util.find_spec("iceoryx2") else "not installed (pip install iceoryx2)"
     out["dora-rs"] = (
         "needs a dora daemon and dataflow (not started by this bench)"
@@ -131,7 +134,9 @@ async def _aiorobot_sender(port: int) -> None:
         await _serve_stdin(_sender_commands(small, picture))
 
 
-async def _zenoh_receiver(port: int) -> None:
+async def _zenoh_receiver(port: int, service: str = _SERVICE, hop: bool = False) -> None:
+    """Bare zenoh-python; with ``hop``, each sample is handed to the asyncio loop with
+    ``call_soon_threadsafe`` and stamped there (the least any asyncio program pays)."""
     import zenoh
 
     from ..transport._zenoh import build_session_config
@@ -139,12 +144,16 @@ async def _zenoh_receiver(port: int) -> None:
     rec = _Record()
     cfg, _ = build_session_config(connect=[f"tcp/127.0.0.1:{port}"])
     session = zenoh.open(cfg)
+    loop = asyncio.get_running_loop()
 
     def on_sample(sample: Any) -> None:
         data = sample.payload.to_bytes()
-        rec.got(*_unstamp(data))
+        if hop:
+            loop.call_soon_threadsafe(rec.got, *_unstamp(data))
+        else:
+            rec.got(*_unstamp(data))
 
-    sub = session.declare_subscriber(f"{_SERVICE}/*", on_sample)
+    sub = session.declare_subscriber(f"{service}/*", on_sample)
     try:
         await _serve_stdin(lambda cmd: rec.report())
     finally:
@@ -152,7 +161,7 @@ async def _zenoh_receiver(port: int) -> None:
         session.close()
 
 
-async def _zenoh_sender(port: int) -> None:
+async def _zenoh_sender(port: int, service: str = _SERVICE) -> None:
     import zenoh
     from zenoh.shm import GarbageCollect, ShmProvider
 
@@ -161,8 +170,8 @@ async def _zenoh_sender(port: int) -> None:
     cfg, _ = build_session_config(connect=[f"tcp/127.0.0.1:{port}"])
     session = zenoh.open(cfg)
     shm = ShmProvider.default_backend(48 * 1024 * 1024)
-    pub = session.declare_publisher(f"{_SERVICE}/small", congestion_control=zenoh.CongestionControl.DROP)
-    img = session.declare_publisher(f"{_SERVICE}/image", congestion_control=zenoh.CongestionControl.DROP)
+    pub = session.declare_publisher(f"{service}/small", congestion_control=zenoh.CongestionControl.DROP)
+    img = session.declare_publisher(f"{service}/image", congestion_control=zenoh.CongestionControl.DROP)
     pixels = bytes(IMAGE_BYTES - 9)
 
     def small(kind: int) -> None:
@@ -301,6 +310,8 @@ _ROLES = {
     ("send", "aiorobot"): _aiorobot_sender,
     ("recv", "zenoh"): _zenoh_receiver,
     ("send", "zenoh"): _zenoh_sender,
+    ("recv", "zenoh-loop"): lambda port: _zenoh_receiver(port, f"{_SERVICE}-loop", hop=True),
+    ("send", "zenoh-loop"): lambda port: _zenoh_sender(port, f"{_SERVICE}-loop"),
     ("recv", "iceoryx2"): _iceoryx2_receiver,
     ("send", "iceoryx2"): _iceoryx2_sender,
 }
@@ -490,6 +501,7 @@ def table(part: dict[str, Any]) -> Any:
     names = {
         "aiorobot": "aiorobot Runtime + ZenohTransport",
         "zenoh": "bare zenoh-python put -> callback",
+        "zenoh-loop": "bare zenoh-python -> asyncio loop",
         "iceoryx2": "iceoryx2 pub/sub + event",
     }
     for path, fig in part.get("paths", {}).items():
@@ -519,7 +531,7 @@ def table(part: dict[str, Any]) -> Any:
 if __name__ == "__main__":
     _role, _path, _port = sys.argv[1], sys.argv[2], int(sys.argv[3])
     if (_role, _path) not in _ROLES:
-        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, iceoryx2; found {sys.argv[1:3]}",
+        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2; found {sys.argv[1:3]}",
               file=sys.stderr)
         sys.exit(2)
     from .. import run as _aiorun
