@@ -113,7 +113,8 @@ class Publisher(Endpoint, Generic[M]):
         self._subs: tuple[Subscription | Tap, ...] = ()
         self._same_loop: tuple[Subscription, ...] = ()
         self._own_loop: asyncio.AbstractEventLoop | None = None
-        self._other_loops: tuple[tuple[asyncio.AbstractEventLoop, tuple[Subscription, ...]], ...] = ()
+        # (loop, its thread's id, its subscriptions) for every loop but this publisher's own
+        self._other_loops: tuple[tuple[asyncio.AbstractEventLoop, int | None, tuple[Subscription, ...]], ...] = ()
         self._taps: tuple[Tap, ...] = ()
         self._keepers = False  # a receiver keeps what is published: it gets a copy (see _accept)
         self._thread_id: int | None = None
@@ -193,7 +194,7 @@ class Publisher(Endpoint, Generic[M]):
         self._subs = subs
         self._keepers = bool(same or other or any(tap.keeps for tap in taps))
         self._same_loop = tuple(same)
-        self._other_loops = tuple((loop, tuple(group)) for loop, group in other.items())
+        self._other_loops = tuple((loop, group[0].node._thread_id, tuple(group)) for loop, group in other.items())
         self._taps = tuple(taps)
 
     def _report_matched(self, subs: tuple[Subscription | Tap, ...], leaving: Endpoint | None) -> None:
@@ -274,9 +275,11 @@ class Publisher(Endpoint, Generic[M]):
 
     def _fan_out(self, msg: Any, meta: Any = None) -> None:
         """Hand ``msg`` (with ``meta``, the MessageInfo data, when not None) to every matched
-        subscription: inline for this loop's when called on its thread, posted to the others'
-        loops; taps take ``msg`` inline."""
-        if threading.get_ident() == self._thread_id:
+        subscription: inline for those of the loop whose thread this is, posted to the others'
+        loops; taps take ``msg`` inline. (A transport publishes what it received on the loop of the
+        subscriptions it is for, the priority loop's included.)"""
+        here = threading.get_ident()
+        if here == self._thread_id:
             if meta is None:
                 for sub in self._same_loop:
                     sub._enqueue(msg)
@@ -284,8 +287,11 @@ class Publisher(Endpoint, Generic[M]):
                 _deliver_all(self._same_loop, msg, meta)
         elif self._same_loop and self._own_loop is not None:
             _post_to(self._own_loop, self._same_loop, msg, meta)
-        for loop, subs in self._other_loops:
-            _post_to(loop, subs, msg, meta)
+        for loop, thread_id, subs in self._other_loops:
+            if thread_id == here:
+                _deliver_all(subs, msg, meta) if meta is not None else _enqueue_all(subs, msg)
+            else:
+                _post_to(loop, subs, msg, meta)
         for tap in self._taps:
             tap._enqueue(msg)
 

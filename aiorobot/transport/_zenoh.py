@@ -41,6 +41,7 @@ from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, Reliabilit
 from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
 from .._core._transport import Transport
+from ..lowlevel import node_loop
 from ..msgs import DeserializationError as _DeserializationError
 from ..msgs import deserialize as _deserialize
 from ..msgs import serialize as _serialize
@@ -381,6 +382,7 @@ class _Inbound:
         self.fallback = _Injector(transport._owner, msg_type, topic, _FALLBACK_QOS, "<zenoh>", hidden=True, fresh=True)
         self._injector: _Injector | None = None  # the injector of the last sample's GID
         self._gid = b""
+        self.inbox: _Inbox | None = None  # the loop's that delivers it; None: the main loop's
 
     def add(self, sub: Any) -> None:
         self.subscriptions.append(sub)
@@ -393,6 +395,10 @@ class _Inbound:
     def _rechunk(self) -> None:
         depths = [s.qos.depth for s in self.subscriptions if s.qos.history is HistoryPolicy.KEEP_LAST]
         self.chunk = max(1, min([MAX_CHUNK, *depths]))
+        # Delivered by the loop of a subscription off the main loop when there is one (the priority
+        # loop: a blocked main loop must not hold its inputs back), main-loop ones then by a post.
+        loops = [node_loop(s.node) for s in self.subscriptions if getattr(s, "node", None) is not None]
+        self.inbox = next((i for i in map(self.transport._inbox_for, loops) if i is not None), None)
 
     def declare(self, qos: QoSProfile) -> None:
         import zenoh
@@ -479,6 +485,82 @@ class _Inbound:
             self.zsub = None
 
 
+class _Inbox:
+    """Received messages on their way to one loop: ``(inbound, (gid, message))`` in arrival order,
+    injected there by :meth:`drain`, one drain due at a time.
+
+    Each loop has its own, so that a topic whose subscriptions run on the priority loop is
+    delivered by that loop even while a main-loop callback blocks."""
+
+    def __init__(self, transport: ZenohTransport, loop: asyncio.AbstractEventLoop | None) -> None:
+        self.transport = transport
+        self._fixed_loop = loop  # None: the transport's (main) loop, known once it opens
+        self.pending: deque[tuple[_Inbound, Any]] = deque()
+        self.armed = False  # a drain is due on the loop
+        self._arming = threading.Lock()
+
+    @property
+    def loop(self) -> asyncio.AbstractEventLoop | None:
+        return self._fixed_loop or self.transport._loop
+
+    def put(self, inbound: _Inbound, decoded: Any) -> None:
+        """On a zenoh thread: queue a decoded message; wake the loop if no drain is due."""
+        pending = self.pending
+        if len(pending) >= BACKLOG_LIMIT:
+            lost, _ = pending.popleft()
+            self.transport._warn(
+                "backlog", f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
+                if self._fixed_loop is None else
+                f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the priority loop"
+            )
+        pending.append((inbound, decoded))
+        if not self.armed:  # (a drain woken before the decoding ran meanwhile and found nothing)
+            self.arm()
+
+    def arm(self) -> None:
+        with self._arming:
+            if self.armed:
+                return
+            self.armed = True
+        loop = self.loop
+        if loop is not None:
+            post(loop, self.drain)
+
+    def drain(self) -> None:
+        """On the inbox's loop: inject queued messages in arrival order, at most ``chunk`` of one
+        topic (its smallest subscription depth) before the dispatchers run; then the next drain.
+        One drain is due at a time; messages that pile up while the process is descheduled so never
+        fill a subscription queue past its depth, and topics keep their relative order."""
+        pending = self.pending
+        local = self.transport._local
+        taken: dict[int, int] = {}
+        local.injecting = True
+        try:
+            for _ in range(MAX_DRAIN):
+                try:
+                    inbound, decoded = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
+                except IndexError:
+                    break
+                n = taken.get(id(inbound), 0)
+                if n >= inbound.chunk:
+                    pending.appendleft(item)  # the topic's dispatchers run first
+                    break
+                taken[id(inbound)] = n + 1
+                if inbound.zsub is None:
+                    continue  # the topic's last subscription left meanwhile
+                inbound._inject(*decoded)
+        finally:
+            local.injecting = False
+        loop = self.loop
+        if not pending or loop is None or loop.is_closed():
+            with self._arming:
+                self.armed = False
+                if not pending or loop is None or loop.is_closed():
+                    return
+                self.armed = True  # a sample came in between: it would wait for the next one
+        loop.call_soon(self.drain)
+
+
 class ZenohTransport(Transport):
     """Joins every aiorobot process (and ROS 2 node on rmw_zenoh) on the same zenoh network and domain.
 
@@ -559,10 +641,10 @@ class ZenohTransport(Transport):
         self._received_shm = 0
         self._drops_shm_full = 0  # sends that fell back to the network because the pool was full
         self._shm_lock = threading.Lock()
-        # received samples on their way to the main loop: (inbound, sample), in arrival order
-        self._pending: deque[tuple[_Inbound, Any]] = deque()
-        self._armed = False  # a drain is due on the loop
-        self._arming = threading.Lock()
+        # received messages on their way to the main loop, and to the other loops (the priority
+        # loop) their topics' subscriptions run on
+        self._inbox = _Inbox(self, None)
+        self._inboxes: dict[asyncio.AbstractEventLoop, _Inbox] = {}
 
     def __repr__(self) -> str:
         state = f"zid={self._zid}" if self._session is not None else "closed"
@@ -651,7 +733,8 @@ class ZenohTransport(Transport):
                 token.undeclare()
             self._outbound.clear()
             self._inbound.clear()
-            self._pending.clear()
+            self._inbox.pending.clear()
+            self._inboxes.clear()
             self._queryables.clear()
             self._tokens.clear()
             self._nodes.clear()
@@ -736,66 +819,27 @@ class ZenohTransport(Transport):
             post(self._loop, fn, *args)
 
     def _queue(self, inbound: _Inbound, sample: Any) -> None:
-        """On a zenoh thread: wake the loop, then check and decode the sample and queue it.
+        """On a zenoh thread: wake the loop the topic's subscriptions run on, then check and decode
+        the sample and queue it in that loop's inbox.
 
         The loop is woken first (unless a drain is due already: one ``call_soon_threadsafe`` per
         batch of samples that arrive together), so that its wake-up (~30 us on this machine's
         2-CPU VM, ~90 us after an image) overlaps the decoding instead of following it."""
-        if not self._armed:
-            self._arm()
+        inbox = inbound.inbox or self._inbox
+        if not inbox.armed:
+            inbox.arm()
         decoded = inbound._decode(sample)
-        if decoded is None:
-            return
-        pending = self._pending
-        if len(pending) >= BACKLOG_LIMIT:
-            lost, _ = pending.popleft()
-            self._warn(
-                "backlog", f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
-            )
-        pending.append((inbound, decoded))
-        if not self._armed:  # the drain woken above ran (and found nothing) while this one decoded
-            self._arm()
+        if decoded is not None:
+            inbox.put(inbound, decoded)
 
-    def _arm(self) -> None:
-        with self._arming:
-            if self._armed:
-                return
-            self._armed = True
-        self._to_loop(self._drain)
-
-    def _drain(self) -> None:
-        """On the main loop: inject queued messages in arrival order, at most ``chunk`` of one
-        topic (its smallest subscription depth) before the dispatchers run; then the next drain.
-        One drain is due at a time; messages that pile up while the process is descheduled so never
-        fill a subscription queue past its depth, and topics keep their relative order."""
-        pending = self._pending
-        local = self._local
-        taken: dict[int, int] = {}
-        local.injecting = True
-        try:
-            for _ in range(MAX_DRAIN):
-                try:
-                    inbound, decoded = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
-                except IndexError:
-                    break
-                n = taken.get(id(inbound), 0)
-                if n >= inbound.chunk:
-                    pending.appendleft(item)  # the topic's dispatchers run first
-                    break
-                taken[id(inbound)] = n + 1
-                if inbound.zsub is None:
-                    continue  # the topic's last subscription left meanwhile
-                inbound._inject(*decoded)
-        finally:
-            local.injecting = False
-        loop = self._loop
-        if not pending or loop is None or loop.is_closed():
-            with self._arming:
-                self._armed = False
-                if not pending or loop is None or loop.is_closed():
-                    return
-                self._armed = True  # a sample came in between: it would wait for the next one
-        loop.call_soon(self._drain)
+    def _inbox_for(self, loop: asyncio.AbstractEventLoop | None) -> _Inbox | None:
+        """The inbox of ``loop`` (None: the main loop's)."""
+        if loop is None or loop is self._loop:
+            return None
+        inbox = self._inboxes.get(loop)
+        if inbox is None:
+            inbox = self._inboxes[loop] = _Inbox(self, loop)
+        return inbox
 
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)

@@ -149,6 +149,33 @@ async def test_a_received_image_is_a_read_only_view_into_the_payload(router_port
         assert isinstance(_root(data), bytes)  # the payload's bytes, decoded in place
 
 
+async def test_a_priority_loop_subscription_receives_while_the_main_loop_is_blocked(router_port: int) -> None:
+    """A remote topic whose subscription runs on the priority loop is delivered by that loop: a
+    main-loop callback that blocks does not hold back a remote /cmd_vel for the controller."""
+    import threading
+
+    async with _beside(DRIVER, router_port, "watcher") as (child, rt, _):
+        control = rt.add_node(Node("controller"), executor="priority")
+        got: list[int] = []
+        arrived = threading.Event()
+
+        def on_cmd(msg: Twist) -> None:
+            got.append(int(msg.linear.x))
+            if msg.linear.x >= 19:
+                arrived.set()
+
+        control.create_subscription(Twist, "/cmd_vel", on_cmd, QoSProfile(depth=50))
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        child.send("steady 20")
+        assert child.proc.stdin is not None
+        await child.proc.stdin.drain()
+        # the main loop blocks (a synchronous wait) until the priority loop has had all 20
+        assert arrived.wait(timeout=30), f"the priority loop got {[x for x in got if x >= 0]} while the main loop was blocked"
+        assert [x for x in got if x >= 0] == list(range(20))
+        await child.expect("done")
+        child.send("bye")
+
+
 async def test_a_received_message_is_in_the_form_a_local_publish_delivers(router_port: int) -> None:
     """Decoded in place and handed over without the publish copy: its sequences and arrays are
     read-only as a local publish makes them, and the subscriptions of one topic share it."""
