@@ -51,7 +51,8 @@ from ._dds_wire import (
     topic_name,
     user_data,
 )
-from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer, _ThreadFlags
+from .._core._handoff import post
+from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer, _ThreadFlags, delivery_loop
 
 if TYPE_CHECKING:
     from .._core._bus import Bus
@@ -256,10 +257,12 @@ class _Inbound:
             old.__del__()
 
     def _on_data(self, reader: Any) -> None:
-        """On a Cyclone thread: take, check and decode, then hand over to the main loop."""
+        """On a Cyclone thread: take, check and decode, then hand over to the loop the topic's
+        subscriptions run on (the priority loop's when one runs there, else the main loop)."""
         transport = self.transport
         from ..msgs import DeserializationError, deserialize
 
+        loop = delivery_loop(self.subscriptions, transport._loop)  # the priority loop's, if one subscribes
         for data, info in transport._take(reader):
             if not info.valid_data:
                 continue
@@ -276,7 +279,8 @@ class _Inbound:
                 transport._warn("other", f"dropped a sample on rt{self.topic}: {type(err).__name__}: {err}")
                 continue
             transport._received += 1
-            transport._to_loop(transport._inject, self, handle, msg)
+            if loop is not None:
+                post(loop, transport._inject, self, handle, msg)
 
 
 class _ServiceSide:

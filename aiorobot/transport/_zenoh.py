@@ -395,10 +395,7 @@ class _Inbound:
     def _rechunk(self) -> None:
         depths = [s.qos.depth for s in self.subscriptions if s.qos.history is HistoryPolicy.KEEP_LAST]
         self.chunk = max(1, min([MAX_CHUNK, *depths]))
-        # Delivered by the loop of a subscription off the main loop when there is one (the priority
-        # loop: a blocked main loop must not hold its inputs back), main-loop ones then by a post.
-        loops = [node_loop(s.node) for s in self.subscriptions if getattr(s, "node", None) is not None]
-        self.inbox = next((i for i in map(self.transport._inbox_for, loops) if i is not None), None)
+        self.inbox = self.transport._inbox_for(delivery_loop(self.subscriptions, self.transport._loop))
 
     def declare(self, qos: QoSProfile) -> None:
         import zenoh
@@ -483,6 +480,18 @@ class _Inbound:
         if self.zsub is not None:
             self.zsub.undeclare()
             self.zsub = None
+
+
+def delivery_loop(subscriptions: list[Any], main: asyncio.AbstractEventLoop | None) -> asyncio.AbstractEventLoop | None:
+    """The loop a topic's received messages are injected on: that of a subscription off the main
+    loop when there is one (the priority loop: a blocked main loop must not hold its inputs back;
+    main-loop subscriptions of the topic then get them by a post), else ``main``."""
+    for sub in subscriptions:
+        node = getattr(sub, "node", None)
+        loop = node_loop(node) if node is not None else None
+        if loop is not None and loop is not main:
+            return loop
+    return main
 
 
 class _Inbox:

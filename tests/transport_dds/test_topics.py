@@ -4,6 +4,7 @@ domains, USER_DATA type hashes, malformed samples and mismatched types."""
 from __future__ import annotations
 
 import asyncio
+import json
 import logging
 from typing import Any
 
@@ -177,3 +178,31 @@ async def test_a_remote_type_name_or_qos_mismatch_is_reported_as_on_the_bus(peer
         await wait_until(lambda: len(rt.graph.incompatible_qos) == 2)
         found = {(i.topic, i.kind, i.subscription_node) for i in rt.graph.incompatible_qos}
     assert found == {("/chatter", "type mismatch", "/picky"), ("/reliable_only", "incompatible QoS", "/picky")}
+
+
+async def test_a_priority_loop_subscription_receives_while_the_main_loop_is_blocked(peer: BarePeer, domain_id: int) -> None:
+    """A DDS topic whose subscription runs on the priority loop is handed to that loop, not through
+    the main loop: a blocked main-loop callback does not hold back a remote /cmd_vel."""
+    import threading
+
+    async with dds_runtime(domain_id) as rt:
+        control = rt.add_node(Node("controller"), executor="priority")
+        arrived = threading.Event()
+        got: list[float] = []
+
+        def on_cmd(msg: Twist) -> None:
+            got.append(msg.linear.x)
+            arrived.set()
+
+        control.create_subscription(Twist, "/cmd_vel", on_cmd, 10)
+        await peer.cmd(op="writer", id="t", topic="rt/cmd_vel", type="Twist", hash=type_hash(Twist))
+        assert (await peer.cmd(op="matched", id="t"))["matched"]
+        write = {"op": "write", "id": "t", "type": "Twist",
+                 "value": {"linear": {"x": 0.75, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}}}
+        assert peer.proc.stdin is not None
+        peer.proc.stdin.write((json.dumps(write) + "\n").encode())
+        await peer.proc.stdin.drain()
+        # the main loop blocks (a synchronous wait) before the peer writes, until the priority loop has it
+        assert arrived.wait(timeout=20), "the priority loop got nothing while the main loop was blocked"
+        assert got == [0.75]
+        await peer._line(peer.proc)  # the peer's answer to the write
