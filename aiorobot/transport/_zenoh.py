@@ -41,7 +41,6 @@ from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, Reliabilit
 from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
 from .._core._transport import Transport
-from ..lowlevel import node_loop
 from ..msgs import DeserializationError as _DeserializationError
 from ..msgs import deserialize as _deserialize
 from ..msgs import serialize as _serialize
@@ -488,7 +487,7 @@ def delivery_loop(subscriptions: list[Any], main: asyncio.AbstractEventLoop | No
     main-loop subscriptions of the topic then get them by a post), else ``main``."""
     for sub in subscriptions:
         node = getattr(sub, "node", None)
-        loop = node_loop(node) if node is not None else None
+        loop = node._loop if node is not None else None  # (lowlevel.node_loop; importing lowlevel loads launch)
         if loop is not None and loop is not main:
             return loop
     return main
