@@ -24,6 +24,7 @@ load falls on all of them alike; figures are pooled over the rounds.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import socket
 import subprocess
@@ -343,8 +344,11 @@ class _Peer:
 
     def ask(self, command: str) -> dict[str, Any]:
         assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write(command + "\n")
-        self.proc.stdin.flush()
+        try:
+            self.proc.stdin.write(command + "\n")
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            raise RuntimeError(f"the {self.path} {self.role} process ended (exit status {self.proc.wait()})") from None
         line = self.proc.stdout.readline()
         if not line:
             raise RuntimeError(f"the {self.path} {self.role} process ended (exit status {self.proc.wait()})")
@@ -352,12 +356,15 @@ class _Peer:
 
     def close(self) -> None:
         if self.proc.stdin is not None:
-            self.proc.stdin.close()
+            with contextlib.suppress(BrokenPipeError):  # a peer that ended leaves a command unflushed
+                self.proc.stdin.close()
         try:
             self.proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
+        if self.proc.stdout is not None:
+            self.proc.stdout.close()
 
 
 def _stats(values_ns: list[int]) -> dict[str, Any]:
