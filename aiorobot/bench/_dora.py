@@ -1,0 +1,248 @@
+"""The ``dora-rs`` row of ``aiorobot bench latency --only zenoh``: the bench's own message pair
+through two dora-rs Python nodes.
+
+The parent (:class:`DoraDataflow`) starts a dora coordinator and daemon of its own on free loopback
+ports (``dora coordinator --store memory``, ``dora daemon --local-listen-port``), in a temporary
+directory, and starts a dataflow whose two nodes are *dynamic* (``path: dynamic``): the bench's
+sender and receiver processes join it with ``Node("sender"|"receiver", daemon_port=...)``, so they
+answer the same stdin commands as every other path's pair. ``close()`` stops the dataflow and ends
+the daemon and the coordinator (their process groups), also when a peer failed.
+
+The sender puts the small message on output ``small`` as ``bytes`` and the image on output
+``image`` as a ``pyarrow`` array over a numpy buffer (dora copies it once into shared memory; the
+receiver gets a ``pyarrow`` array over that memory, read here through a zero-copy numpy view).
+The receiver blocks in ``node.next()`` on a thread of its own and stamps each message there, as the
+iceoryx2 receiver does on its listener thread (no busy polling: ``next`` waits in dora's Rust code
+with the GIL released; its timeout only lets the thread see the end of the run).
+
+dora is optional: nothing here is imported unless ``dora`` is importable, and a dora that cannot
+start says why in its row.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from ._zenoh import IMAGE_BYTES, SMALL_BYTES, _free_port, _Record, _sender_commands, _serve_stdin, _stamp_bytes, _unstamp
+
+__all__ = ["DoraDataflow", "dora_cli"]
+
+_DATAFLOW = """\
+nodes:
+  - id: sender
+    path: dynamic
+    outputs:
+      - small
+      - image
+  - id: receiver
+    path: dynamic
+    inputs:
+      small: sender/small
+      image: sender/image
+"""
+_START_TIMEOUT_SEC = 20.0
+
+
+def dora_cli() -> str | None:
+    """The ``dora`` command beside this Python (a venv's ``bin``), else on ``PATH``."""
+    here = Path(sys.executable).with_name("dora")
+    return str(here) if here.exists() else shutil.which("dora")
+
+
+def _first_line(text: str) -> str:
+    """The message of a dora CLI error (its output carries an ``[ERROR]`` header and a backtrace)."""
+    for line in text.splitlines():
+        line = line.strip()
+        if line.startswith(("Location:", "Stack backtrace:")):
+            break
+        if line and line != "[ERROR]":
+            return line
+    return "no output"
+
+
+class DoraDataflow:
+    """A dora coordinator, a daemon and the bench's dataflow, on loopback ports of their own.
+
+    ``start()`` raises ``RuntimeError`` with one line saying what did not start; ``close()`` leaves
+    no dora process behind (it is safe to call after a failed ``start()``)."""
+
+    def __init__(self) -> None:
+        self.daemon_port = 0
+        self._procs: list[subprocess.Popen[bytes]] = []
+        self._dir: tempfile.TemporaryDirectory[str] | None = None
+        self._cli: str | None = None
+        self._env: dict[str, str] = {}
+
+    def __repr__(self) -> str:
+        alive = sum(p.poll() is None for p in self._procs)
+        return f"<DoraDataflow daemon_port={self.daemon_port} processes={alive}>"
+
+    def start(self) -> None:
+        self._cli = dora_cli()
+        if self._cli is None:
+            raise RuntimeError("dora CLI not found (pip install dora-rs-cli)")
+        self._dir = tempfile.TemporaryDirectory(prefix="aiorobot-bench-dora-")
+        cwd = self._dir.name
+        coordinator_port, self.daemon_port = _free_port(), _free_port()
+        self._env = {**os.environ, "DORA_COORDINATOR_ADDR": "127.0.0.1", "DORA_COORDINATOR_PORT": str(coordinator_port),
+                     "RUST_BACKTRACE": "0", "RUST_LIB_BACKTRACE": "0",
+                     "TMPDIR": cwd}  # the daemon's dora-artifacts-* go with the directory
+        Path(cwd, "dataflow.yml").write_text(_DATAFLOW)
+        self._spawn("coordinator", "--interface", "127.0.0.1", "--port", str(coordinator_port), "--store", "memory", "--quiet")
+        self._spawn("daemon", "--coordinator-port", str(coordinator_port), "--local-listen-port", str(self.daemon_port),
+                    "--zenoh-no-multicast")
+        deadline = time.monotonic() + _START_TIMEOUT_SEC
+        while True:  # until the daemon has registered with the coordinator
+            for proc, what in zip(self._procs, ("coordinator", "daemon")):
+                if proc.poll() is not None:
+                    raise RuntimeError(f"the dora {what} did not start: {_first_line(self._output(proc))}")
+            done = subprocess.run([self._cli, "start", "dataflow.yml", "--detach", "--name", "aiorobot-bench"],
+                                  cwd=cwd, env=self._env, capture_output=True, text=True, check=False)
+            if done.returncode == 0:
+                return
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"the dora dataflow did not start in {_START_TIMEOUT_SEC:.0f} s: "
+                                   f"{_first_line(done.stderr or done.stdout)}")
+            time.sleep(0.2)
+
+    def _spawn(self, *args: str) -> None:
+        assert self._cli is not None and self._dir is not None
+        log = open(Path(self._dir.name, f"{args[0]}.log"), "wb")  # noqa: SIM115 (closed with the process)
+        with log:
+            self._procs.append(subprocess.Popen([self._cli, *args], cwd=self._dir.name, env=self._env,
+                                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                                start_new_session=True))
+
+    def _output(self, proc: subprocess.Popen[bytes]) -> str:
+        assert self._dir is not None
+        what = "coordinator" if proc is self._procs[0] else "daemon"
+        return Path(self._dir.name, f"{what}.log").read_text(errors="replace")
+
+    def close(self) -> None:
+        if self._cli is not None and all(p.poll() is None for p in self._procs) and self._procs:
+            subprocess.run([self._cli, "stop", "--all", "--grace-duration", "2s"], env=self._env,
+                           capture_output=True, timeout=15, check=False)
+        for proc in reversed(self._procs):  # the daemon, then the coordinator
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGTERM)
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+        self._procs.clear()
+        if self._dir is not None:
+            self._dir.cleanup()
+            self._dir = None
+
+    def __enter__(self) -> DoraDataflow:
+        try:
+            self.start()
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# -- the peers (``python -m aiorobot.bench._zenoh ROLE dora-rs DAEMON_PORT``) ----------------------
+
+
+def _protocol_stdout() -> None:
+    """dora nodes write their log lines (JSON, one per image sent in dora 1.1) to file descriptor 1,
+    where the bench's command protocol runs: point fd 1 at /dev/null and keep the protocol on a
+    duplicate of the original."""
+    protocol = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.close(devnull)
+    sys.stdout = os.fdopen(protocol, "w", buffering=1)
+
+
+async def receiver(daemon_port: int) -> None:
+    _protocol_stdout()
+    rec = _Record()
+    joined: concurrent.futures.Future[None] = concurrent.futures.Future()
+    stop = threading.Event()
+
+    def pump() -> None:
+        from dora import Node
+
+        try:
+            node = Node("receiver", daemon_port=daemon_port)
+        except Exception as err:  # noqa: BLE001 (reported as the peer's one line)
+            joined.set_exception(err)
+            return
+        joined.set_result(None)
+        while not stop.is_set():
+            event = node.next(timeout=0.1)
+            if event is None:  # every sender gone
+                return
+            if event["type"] == "INPUT":
+                rec.got(*_unstamp(event["value"].to_numpy(zero_copy_only=True)))
+            elif event["type"] == "STOP":
+                return
+
+    thread = threading.Thread(target=pump, name="dora-receiver", daemon=True)
+    thread.start()
+    if (why := await _joined(joined, "receiver", daemon_port)) is not None:
+        print(why, flush=True)
+        return
+    try:
+        await _serve_stdin(lambda cmd: rec.report())
+    finally:
+        stop.set()
+        await asyncio.to_thread(thread.join)
+
+
+async def sender(daemon_port: int) -> None:
+    import numpy as np
+    import pyarrow as pa
+    from dora import Node
+
+    _protocol_stdout()
+    try:
+        node = Node("sender", daemon_port=daemon_port)
+    except Exception as err:  # noqa: BLE001 (reported as the peer's one line)
+        print(_node_error("sender", daemon_port, err), flush=True)
+        return
+    pixels = np.zeros(IMAGE_BYTES, dtype=np.uint8)
+    image = pa.array(pixels)  # over the numpy buffer: the stamp written in place is in it
+
+    def small(kind: int) -> None:
+        node.send_output("small", _stamp_bytes(kind, SMALL_BYTES))
+
+    def picture() -> None:
+        pixels[:9] = np.frombuffer(time.monotonic_ns().to_bytes(8, "little") + b"\x02", dtype=np.uint8)
+        node.send_output("image", image)
+
+    await _serve_stdin(_sender_commands(small, picture))
+
+
+async def _joined(joined: concurrent.futures.Future[None], node_id: str, daemon_port: int) -> str | None:
+    try:
+        await asyncio.wrap_future(joined)
+    except Exception as err:  # noqa: BLE001
+        return _node_error(node_id, daemon_port, err)
+    return None
+
+
+def _node_error(node_id: str, daemon_port: int, err: Exception) -> str:
+    """One line from dora's error (its text goes on with a cause chain and a location)."""
+    lines = [line.strip() for line in str(err).splitlines() if line.strip()]
+    if not lines:
+        lines = [repr(err)]
+    cause = f"{lines[0]}: {lines[lines.index('Caused by:') + 1]}" if "Caused by:" in lines[:-1] else lines[0]
+    return f"dora node {node_id!r} could not join the daemon on port {daemon_port}: {cause}"
