@@ -6,7 +6,8 @@ ports (``dora coordinator --store memory``, ``dora daemon --local-listen-port``)
 directory, and starts a dataflow whose two nodes are *dynamic* (``path: dynamic``): the bench's
 sender and receiver processes join it with ``Node("sender"|"receiver", daemon_port=...)``, so they
 answer the same stdin commands as every other path's pair. ``close()`` stops the dataflow and ends
-the daemon and the coordinator (their process groups), also when a peer failed.
+the daemon and the coordinator (their process groups), also when a peer failed; on Linux the two
+also get SIGTERM if the bench process is killed outright.
 
 The sender puts the small message on output ``small`` as ``bytes`` and the image on output
 ``image`` as a ``pyarrow`` array over a numpy buffer (dora copies it once into shared memory; the
@@ -32,6 +33,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 from ._zenoh import IMAGE_BYTES, SMALL_BYTES, _free_port, _Record, _sender_commands, _serve_stdin, _stamp_bytes, _unstamp
 
@@ -51,12 +53,25 @@ nodes:
       image: sender/image
 """
 _START_TIMEOUT_SEC = 20.0
+_PR_SET_PDEATHSIG = 1
 
 
 def dora_cli() -> str | None:
     """The ``dora`` command beside this Python (a venv's ``bin``), else on ``PATH``."""
     here = Path(sys.executable).with_name("dora")
     return str(here) if here.exists() else shutil.which("dora")
+
+
+def _die_with_parent() -> Any:
+    """A ``preexec_fn`` that has Linux send the child SIGTERM when the process (thread) that started it
+    ends, so a bench killed outright leaves no dora daemon behind (None elsewhere). libc is loaded
+    here, before the fork: the child only makes the one call."""
+    if not sys.platform.startswith("linux"):
+        return None
+    import ctypes
+
+    prctl = ctypes.CDLL(None, use_errno=True).prctl
+    return lambda: prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
 
 
 def _first_line(text: str) -> str:
@@ -121,7 +136,7 @@ class DoraDataflow:
         with log:
             self._procs.append(subprocess.Popen([self._cli, *args], cwd=self._dir.name, env=self._env,
                                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                                start_new_session=True))
+                                                start_new_session=True, preexec_fn=_die_with_parent()))
 
     def _output(self, proc: subprocess.Popen[bytes]) -> str:
         assert self._dir is not None

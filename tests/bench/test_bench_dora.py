@@ -6,6 +6,10 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import shutil
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -79,6 +83,32 @@ def test_a_dead_receiver_is_an_error_and_dora_still_shuts_down() -> None:
             send.close()
             recv.close()
     assert _dora_processes(flow.daemon_port) == []
+
+
+def test_a_killed_bench_takes_its_dora_daemon_and_coordinator_with_it() -> None:
+    script = (
+        "import sys\n"
+        "from aiorobot.bench._dora import DoraDataflow\n"
+        "flow = DoraDataflow()\n"
+        "flow.start()\n"
+        "print(flow._dir.name, flow.daemon_port, *(p.pid for p in flow._procs), flush=True)\n"
+        "sys.stdin.read()\n"
+    )
+    bench = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        workdir, *numbers = bench.stdout.readline().split()
+        port, *pids = (int(x) for x in numbers)
+        assert len(pids) == 2 and all(os.path.exists(f"/proc/{pid}") for pid in pids)
+    finally:
+        bench.kill()
+        bench.wait()
+        bench.stdin.close()
+        bench.stdout.close()
+    deadline = time.monotonic() + 20
+    while _dora_processes(port) and time.monotonic() < deadline:
+        time.sleep(0.05)  # polling for the processes to end, bounded
+    assert _dora_processes(port) == []
+    shutil.rmtree(workdir)  # what a killed bench cannot remove itself
 
 
 def test_a_node_that_cannot_join_says_why_in_one_line() -> None:
