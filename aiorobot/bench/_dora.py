@@ -24,7 +24,9 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import contextlib
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -74,15 +76,17 @@ def _die_with_parent() -> Any:
     return lambda: prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
 
 
-def _first_line(text: str) -> str:
-    """The message of a dora CLI error (its output carries an ``[ERROR]`` header and a backtrace)."""
+def _error_line(text: str) -> str:
+    """A dora error (``[ERROR]``, a message, ``Caused by:`` and numbered causes, a location and a
+    backtrace) as one line: the message and its causes."""
+    parts = []
     for line in text.splitlines():
         line = line.strip()
         if line.startswith(("Location:", "Stack backtrace:")):
             break
-        if line and line != "[ERROR]":
-            return line
-    return "no output"
+        if line and line not in ("[ERROR]", "Caused by:"):
+            parts.append(re.sub(r"^\d+: ", "", line))
+    return ": ".join(parts) or "no output"
 
 
 class DoraDataflow:
@@ -118,42 +122,51 @@ class DoraDataflow:
                     "--zenoh-no-multicast")
         deadline = time.monotonic() + _START_TIMEOUT_SEC
         while True:  # until the daemon has registered with the coordinator
-            for proc, what in zip(self._procs, ("coordinator", "daemon")):
-                if proc.poll() is not None:
-                    raise RuntimeError(f"the dora {what} did not start: {_first_line(self._output(proc))}")
-            done = subprocess.run([self._cli, "start", "dataflow.yml", "--detach", "--name", "aiorobot-bench"],
-                                  cwd=cwd, env=self._env, capture_output=True, text=True, check=False)
+            self._check_running()
+            try:
+                done = subprocess.run([self._cli, "start", "dataflow.yml", "--detach", "--name", "aiorobot-bench"],
+                                      cwd=cwd, env=self._env, capture_output=True, text=True, check=False,
+                                      timeout=_START_TIMEOUT_SEC)
+            except subprocess.TimeoutExpired:
+                done = None
+            if done is None:
+                self._check_running()
+                raise RuntimeError(f"the dora dataflow did not start: `dora start` gave no answer in "
+                                   f"{_START_TIMEOUT_SEC:.0f} s")
             if done.returncode == 0:
                 return
             if time.monotonic() > deadline:
                 raise RuntimeError(f"the dora dataflow did not start in {_START_TIMEOUT_SEC:.0f} s: "
-                                   f"{_first_line(done.stderr or done.stdout)}")
+                                   f"{_error_line(done.stderr or done.stdout)}")
             time.sleep(0.2)
 
     def _spawn(self, *args: str) -> None:
         assert self._cli is not None and self._dir is not None
-        log = open(Path(self._dir.name, f"{args[0]}.log"), "wb")  # noqa: SIM115 (closed with the process)
-        with log:
+        with open(Path(self._dir.name, f"{args[0]}.log"), "wb") as log:  # the child keeps its own descriptor
             self._procs.append(subprocess.Popen([self._cli, *args], cwd=self._dir.name, env=self._env,
                                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                                 start_new_session=True, preexec_fn=_die_with_parent()))
 
-    def _output(self, proc: subprocess.Popen[bytes]) -> str:
+    def _check_running(self) -> None:
         assert self._dir is not None
-        what = "coordinator" if proc is self._procs[0] else "daemon"
-        return Path(self._dir.name, f"{what}.log").read_text(errors="replace")
+        for proc, what in zip(self._procs, ("coordinator", "daemon")):
+            if proc.poll() is not None:
+                log = Path(self._dir.name, f"{what}.log").read_text(errors="replace")
+                raise RuntimeError(f"the dora {what} did not start: {_error_line(log)}")
 
     def close(self) -> None:
-        if self._cli is not None and all(p.poll() is None for p in self._procs) and self._procs:
-            subprocess.run([self._cli, "stop", "--all", "--grace-duration", "2s"], env=self._env,
-                           capture_output=True, timeout=15, check=False)
+        if self._cli is not None and self._procs and all(p.poll() is None for p in self._procs):
+            with contextlib.suppress(subprocess.TimeoutExpired):  # the processes are ended below anyway
+                subprocess.run([self._cli, "stop", "--all", "--grace-duration", "2s"], env=self._env,
+                               capture_output=True, timeout=15, check=False)
         for proc in reversed(self._procs):  # the daemon, then the coordinator
-            if proc.poll() is None:
+            with contextlib.suppress(ProcessLookupError):  # the group may be gone already
                 os.killpg(proc.pid, signal.SIGTERM)
             try:
                 proc.wait(timeout=10)
             except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(proc.pid, signal.SIGKILL)
                 proc.wait()
         self._procs.clear()
         if self._dir is not None:
@@ -255,9 +268,4 @@ async def _joined(joined: concurrent.futures.Future[None], node_id: str, daemon_
 
 
 def _node_error(node_id: str, daemon_port: int, err: Exception) -> str:
-    """One line from dora's error (its text goes on with a cause chain and a location)."""
-    lines = [line.strip() for line in str(err).splitlines() if line.strip()]
-    if not lines:
-        lines = [repr(err)]
-    cause = f"{lines[0]}: {lines[lines.index('Caused by:') + 1]}" if "Caused by:" in lines[:-1] else lines[0]
-    return f"dora node {node_id!r} could not join the daemon on port {daemon_port}: {cause}"
+    return f"dora node {node_id!r} could not join the daemon on port {daemon_port}: {_error_line(str(err))}"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from aiorobot.bench._dora import DoraDataflow, _first_line, dora_cli
+from aiorobot.bench._dora import DoraDataflow, _error_line, dora_cli
 from aiorobot.bench._zenoh import _Peer, _round, _warm_up
 
 pytestmark = [
@@ -120,7 +120,10 @@ def test_a_node_that_cannot_join_says_why_in_one_line() -> None:
     assert "\n" not in why
 
 
-def test_a_dora_cli_error_reads_as_its_message_line() -> None:
+def test_a_dora_error_reads_as_one_line_with_its_causes() -> None:
     text = "\n[ERROR]\nno unnamed daemon connections\n\nLocation:\n    binaries/cli/src/common.rs:78:48\n"
-    assert _first_line(text) == "no unnamed daemon connections"
-    assert _first_line("") == "no output"
+    assert _error_line(text) == "no unnamed daemon connections"
+    text = ("[ERROR]\nfailed to run dora-coordinator\n\nCaused by:\n   0: failed to start WS server\n"
+            "   1: Address already in use (os error 98)\n\nLocation:\n    binaries/coordinator/src/ws_server.rs:282:20\n")
+    assert _error_line(text) == "failed to run dora-coordinator: failed to start WS server: Address already in use (os error 98)"
+    assert _error_line("") == "no output"
