@@ -17,11 +17,13 @@ import pytest
 from aiorobot.bench._dora import DoraDataflow, _error_line, dora_cli
 from aiorobot.bench._zenoh import _Peer, _round, _warm_up
 
-pytestmark = [
-    pytest.mark.skipif(importlib.util.find_spec("dora") is None, reason="dora-rs not installed (pip install dora-rs)"),
-    pytest.mark.skipif(dora_cli() is None, reason="the dora CLI not installed (pip install dora-rs-cli)"),
-    pytest.mark.timeout(60),
-]
+pytestmark = pytest.mark.timeout(60)
+_MISSING = (
+    "dora-rs not installed (pip install dora-rs)" if importlib.util.find_spec("dora") is None
+    else "the dora CLI not installed (pip install dora-rs-cli)" if dora_cli() is None
+    else None
+)
+needs_dora = pytest.mark.skipif(_MISSING is not None, reason=_MISSING or "")
 
 
 def _dora_processes(port: int) -> list[str]:
@@ -46,6 +48,7 @@ def _start_pair(flow: DoraDataflow) -> tuple[_Peer, _Peer]:
     return recv, send
 
 
+@needs_dora
 def test_dora_path_carries_small_messages_images_and_a_burst_then_leaves_nothing_running() -> None:
     flow = DoraDataflow()
     with flow:
@@ -69,6 +72,7 @@ def test_dora_path_carries_small_messages_images_and_a_burst_then_leaves_nothing
     assert _dora_processes(flow.daemon_port) == []
 
 
+@needs_dora
 def test_a_dead_receiver_is_an_error_and_dora_still_shuts_down() -> None:
     flow = DoraDataflow()
     with flow:
@@ -85,6 +89,7 @@ def test_a_dead_receiver_is_an_error_and_dora_still_shuts_down() -> None:
     assert _dora_processes(flow.daemon_port) == []
 
 
+@needs_dora
 def test_a_killed_bench_takes_its_dora_daemon_and_coordinator_with_it() -> None:
     script = (
         "import sys\n"
@@ -111,6 +116,7 @@ def test_a_killed_bench_takes_its_dora_daemon_and_coordinator_with_it() -> None:
     shutil.rmtree(workdir)  # what a killed bench cannot remove itself
 
 
+@needs_dora
 def test_a_node_that_cannot_join_says_why_in_one_line() -> None:
     with DoraDataflow() as flow:
         wrong = _Peer("send", "dora-rs", flow.daemon_port + 1 if flow.daemon_port < 65535 else flow.daemon_port - 1)
