@@ -12,8 +12,9 @@ Paths (each one a sender process and a receiver process of its own):
   aiorobot's included;
 - ``iceoryx2``: iceoryx2 pub/sub with an event to wake the receiver, when ``iceoryx2`` is
   importable; the image written once into a loaned sample;
-- ``dora-rs`` is listed when importable but not measured (its nodes run under a dora daemon and
-  dataflow, which this bench does not start).
+- ``dora-rs``: two dora-rs Python nodes, when ``dora`` is importable: the bench starts a dora
+  coordinator, daemon and dataflow of its own and its sender and receiver join it as dynamic nodes
+  (:mod:`aiorobot.bench._dora`).
 
 The sender stamps each message with ``time.monotonic_ns()`` (one clock for every process of a Linux
 host); the receiver reports one-way latency (receive minus stamp) and, for a burst sent back to
@@ -24,6 +25,7 @@ load falls on all of them alike; figures are pooled over the rounds.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import socket
 import subprocess
@@ -47,11 +49,7 @@ def available_paths() -> dict[str, str | None]:
 
     out: dict[str, str | None] = {"aiorobot": None, "zenoh": None, "zenoh-loop": None}
     out["iceoryx2"] = None if importlib.util.find_spec("iceoryx2") else "not installed (pip install iceoryx2)"
-    out["dora-rs"] = (
-        "needs a dora daemon and dataflow (not started by this bench)"
-        if importlib.util.find_spec("dora")
-        else "not installed (pip install dora-rs)"
-    )
+    out["dora-rs"] = None if importlib.util.find_spec("dora") else "not installed (pip install dora-rs dora-rs-cli)"
     return out
 
 
@@ -314,7 +312,15 @@ _ROLES = {
     ("send", "zenoh-loop"): lambda port: _zenoh_sender(port, f"{_SERVICE}-loop"),
     ("recv", "iceoryx2"): _iceoryx2_receiver,
     ("send", "iceoryx2"): _iceoryx2_sender,
+    ("recv", "dora-rs"): lambda port: _dora_role("receiver", port),
+    ("send", "dora-rs"): lambda port: _dora_role("sender", port),
 }
+
+
+def _dora_role(name: str, daemon_port: int) -> Any:
+    from . import _dora
+
+    return getattr(_dora, name)(daemon_port)
 
 
 # -- the parent -----------------------------------------------------------------------------------
@@ -343,8 +349,11 @@ class _Peer:
 
     def ask(self, command: str) -> dict[str, Any]:
         assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write(command + "\n")
-        self.proc.stdin.flush()
+        try:
+            self.proc.stdin.write(command + "\n")
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            raise RuntimeError(f"the {self.path} {self.role} process ended (exit status {self.proc.wait()})") from None
         line = self.proc.stdout.readline()
         if not line:
             raise RuntimeError(f"the {self.path} {self.role} process ended (exit status {self.proc.wait()})")
@@ -352,12 +361,15 @@ class _Peer:
 
     def close(self) -> None:
         if self.proc.stdin is not None:
-            self.proc.stdin.close()
+            with contextlib.suppress(BrokenPipeError):  # a peer that ended leaves a command unflushed
+                self.proc.stdin.close()
         try:
             self.proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
+        if self.proc.stdout is not None:
+            self.proc.stdout.close()
 
 
 def _stats(values_ns: list[int]) -> dict[str, Any]:
@@ -390,9 +402,21 @@ def run(quick: bool = False) -> dict[str, Any]:
         for p in paths
     }
     errors: dict[str, str] = {}
+    ports = dict.fromkeys(paths, port)
+    dora = None
     try:
+        if "dora-rs" in paths:  # its peers join a dataflow of their own daemon's (the port they are given)
+            from ._dora import DoraDataflow
+
+            dora = DoraDataflow()
+            try:
+                dora.start()
+                ports["dora-rs"] = dora.daemon_port
+            except RuntimeError as err:
+                errors["dora-rs"] = str(err)
+                del ports["dora-rs"]
         with NoiseMeter() as meter:
-            started = {path: (_Peer("recv", path, port), _Peer("send", path, port)) for path in paths}
+            started = {path: (_Peer("recv", path, p), _Peer("send", path, p)) for path, p in ports.items()}
             for path, (recv, send) in started.items():
                 why = recv.ready() or send.ready()
                 if why is not None:
@@ -419,6 +443,8 @@ def run(quick: bool = False) -> dict[str, Any]:
         for recv, send in pairs.values():
             send.close()
             recv.close()
+        if dora is not None:
+            dora.close()
         router.close()
     rows = {}
     for path in paths:
@@ -503,6 +529,7 @@ def table(part: dict[str, Any]) -> Any:
         "zenoh": "bare zenoh-python put -> callback",
         "zenoh-loop": "bare zenoh-python -> asyncio loop",
         "iceoryx2": "iceoryx2 pub/sub + event",
+        "dora-rs": "dora-rs, two Python dynamic nodes",
     }
     for path, fig in part.get("paths", {}).items():
         if "error" in fig:
@@ -531,7 +558,7 @@ def table(part: dict[str, Any]) -> Any:
 if __name__ == "__main__":
     _role, _path, _port = sys.argv[1], sys.argv[2], int(sys.argv[3])
     if (_role, _path) not in _ROLES:
-        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2; found {sys.argv[1:3]}",
+        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2, dora-rs; found {sys.argv[1:3]}",
               file=sys.stderr)
         sys.exit(2)
     from .. import run as _aiorun
