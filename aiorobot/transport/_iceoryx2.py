@@ -189,6 +189,7 @@ class Iceoryx2Receiver(_Inbound):
                     continue
                 while (sample := subscriber.receive()) is not None:
                     transport._queue(self, sample)
+                    del sample  # not borrowed while the next one is taken (one held past BORROW_MAX - 1)
             except Exception as err:  # noqa: BLE001 - say it, keep receiving
                 transport._warn("iceoryx2", f"receiving {self.topic} over iceoryx2: {type(err).__name__}: {err}")
 

@@ -19,7 +19,7 @@ from aiorobot.msgs._cdr_gen import build_parts_serializer
 from aiorobot.msgs.geometry_msgs import Twist, Vector3
 from aiorobot.msgs.sensor_msgs import Image, PointCloud2, PointField
 from aiorobot.transport import ZenohTransport
-from aiorobot.transport._iceoryx2 import unavailable
+from aiorobot.transport._iceoryx2 import BORROW_MAX, unavailable
 
 from ._helpers import Child, spawn, wait_until
 
@@ -125,6 +125,12 @@ async def test_images_from_another_process_arrive_intact_in_order_as_views_of_th
             assert frames[0] is not frames[1] and receiver.copied == 0
             # published into the bus as the camera's publisher (its GID in the payload), not an unknown one
             assert receiver._injector is not None and receiver._injector.node_name.endswith("camera")
+            # all kept alive (the list holds them): past BORROW_MAX - 1 samples held, messages are copied out
+            more = await _frames(child, rt, images, 6, 6)
+            _check(more, 6)
+            assert receiver.copied == 12 - (BORROW_MAX - 1)
+            assert getattr(_root(more[-1].data), "_sample", None) is None and not more[-1].data.flags.writeable
+            _check(frames, 0)
         finally:
             await child.stop()
 
@@ -132,7 +138,10 @@ async def test_images_from_another_process_arrive_intact_in_order_as_views_of_th
 async def test_a_publisher_killed_with_sigkill_leaves_the_receiver_running_and_a_new_one_delivers(router_port: int) -> None:
     service = f"aiorobot/test/{router_port}/kill"
     async with _viewer(router_port, service) as (rt, images, receiver):
+        before = _iceoryx2_files()
         first = await _camera(router_port, service)
+        segments = {f for f in _iceoryx2_files() - before if f.endswith(".data")}  # its data segment
+        assert segments
         try:
             kept = await _frames(first, rt, images, 0, 3)
             first.proc.send_signal(signal.SIGKILL)
@@ -142,10 +151,12 @@ async def test_a_publisher_killed_with_sigkill_leaves_the_receiver_running_and_a
         await wait_until(lambda: not rt.graph.publishers_of("/image"))  # zenoh saw it go
         _check(kept, 0)  # the frames it sent are still whole: their samples outlive their publisher
         assert receiver._thread.is_alive()
+        assert segments <= _iceoryx2_files()  # what the killed process held stays until someone cleans up
         second = await _camera(router_port, service)
         try:
             _check(await _frames(second, rt, images, 10, 4), 10)
             _check(kept, 0)
+            assert not segments & _iceoryx2_files()  # the new publisher's node released the dead one's memory
         finally:
             await second.stop()
         assert rt.transport.statistics().dropped == 0 and receiver._thread.is_alive()
