@@ -119,7 +119,7 @@ class Iceoryx2Sender:
                 out = transport._outbound.get((self.topic, self.msg_type.__msgtype__))
                 self._gid = out._tail[1:] if out is not None else b"\0" * GID_BYTES
             sample = self._publisher.loan_slice_uninit(GID_BYTES + size)
-            dst = memoryview((ctypes.c_uint8 * (GID_BYTES + size)).from_address(sample.payload().as_ptr())).cast("B")
+            dst = memoryview((ctypes.c_uint8 * (GID_BYTES + size)).from_address(sample.payload_ptr)).cast("B")
             dst[:GID_BYTES] = self._gid
             pos = GID_BYTES
             for part in parts:
@@ -196,9 +196,8 @@ class Iceoryx2Receiver(_Inbound):
     def _decode(self, sample: Any) -> tuple[bytes, Any] | None:
         """On the receiving thread: ``(gid, message)``, the message's arrays viewing the sample."""
         transport = self.transport
-        payload = sample.payload()
-        size = payload.number_of_elements
-        buf = (ctypes.c_uint8 * size).from_address(payload.as_ptr())
+        size = sample.header.number_of_elements  # (bytes; ``payload()`` would build a Slice first)
+        buf = (ctypes.c_uint8 * size).from_address(sample.payload_ptr)
         try:
             if size < GID_BYTES + 4:
                 raise _DeserializationError(f"expected at least {GID_BYTES + 4} bytes, found {size}")
