@@ -12,6 +12,10 @@ Paths (each one a sender process and a receiver process of its own):
   aiorobot's included;
 - ``iceoryx2``: iceoryx2 pub/sub with an event to wake the receiver, when ``iceoryx2`` is
   importable; the image written once into a loaned sample;
+- ``aiorobot-iox``: the ``aiorobot`` pair (domain 1, apart from it) with the image topic over the
+  iceoryx2 data path prototype (``aiorobot.transport._iceoryx2``), when ``iceoryx2`` is importable;
+  its small messages and bursts go over zenoh as the ``aiorobot`` pair's do, so the table leaves
+  them out;
 - ``dora-rs`` is listed when importable but not measured (its nodes run under a dora daemon and
   dataflow, which this bench does not start).
 
@@ -33,7 +37,7 @@ from typing import Any
 
 __all__ = ["PATHS", "available_paths", "run", "table"]
 
-PATHS = ("aiorobot", "zenoh", "zenoh-loop", "iceoryx2", "dora-rs")
+PATHS = ("aiorobot", "zenoh", "zenoh-loop", "iceoryx2", "aiorobot-iox", "dora-rs")
 SMALL_BYTES = 52  # a Twist's CDR
 IMAGE_BYTES = 640 * 480 * 3
 SMALL_HZ = 1000.0
@@ -47,6 +51,7 @@ def available_paths() -> dict[str, str | None]:
 
     out: dict[str, str | None] = {"aiorobot": None, "zenoh": None, "zenoh-loop": None}
     out["iceoryx2"] = None if importlib.util.find_spec("iceoryx2") else "not installed (pip install iceoryx2)"
+    out["aiorobot-iox"] = out["iceoryx2"]
     out["dora-rs"] = (
         "needs a dora daemon and dataflow (not started by this bench)"
         if importlib.util.find_spec("dora")
@@ -92,14 +97,20 @@ def _unstamp(data: Any) -> tuple[int, int]:
     return data[8], int.from_bytes(bytes(data[:8]), "little")
 
 
-async def _aiorobot_receiver(port: int) -> None:
+async def _aiorobot_receiver(port: int, iceoryx2: bool = False) -> None:
+    """With ``iceoryx2``, the image over the iceoryx2 data path prototype (domain 1)."""
     from .. import Node, QoSProfile, Runtime
     from ..msgs.geometry_msgs import Twist
     from ..msgs.sensor_msgs import Image
     from ..transport import ZenohTransport
 
     rec = _Record()
-    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
+    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"])
+    async with Runtime(transport=transport, handle_signals=False) as rt:
+        if iceoryx2:
+            from ..transport._iceoryx2 import Iceoryx2Receiver
+
+            Iceoryx2Receiver(transport, Image, "/bench/image", f"{_SERVICE}/{port}/aiorobot-image")
         node = rt.add_node(Node("bench_sink"))
         node.create_subscription(Twist, "/bench/twist", lambda m: rec.got(int(m.linear.y), int(m.linear.x)), QoSProfile(depth=10))
         node.create_subscription(
@@ -109,7 +120,7 @@ async def _aiorobot_receiver(port: int) -> None:
         await _serve_stdin(lambda cmd: rec.report())
 
 
-async def _aiorobot_sender(port: int) -> None:
+async def _aiorobot_sender(port: int, iceoryx2: bool = False) -> None:
     import numpy as np
 
     from .. import Node, QoSProfile, Runtime
@@ -117,10 +128,15 @@ async def _aiorobot_sender(port: int) -> None:
     from ..msgs.sensor_msgs import Image
     from ..transport import ZenohTransport
 
-    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
+    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"])
+    async with Runtime(transport=transport, handle_signals=False) as rt:
         node = rt.add_node(Node("bench_source"))
         twist = node.create_publisher(Twist, "/bench/twist", QoSProfile(depth=10))
         image = node.create_publisher(Image, "/bench/image", QoSProfile(depth=10))
+        if iceoryx2:
+            from ..transport._iceoryx2 import Iceoryx2Sender
+
+            Iceoryx2Sender(transport, Image, "/bench/image", f"{_SERVICE}/{port}/aiorobot-image", max_bytes=IMAGE_BYTES + 1024)
         data = np.zeros(IMAGE_BYTES, dtype=np.uint8)
 
         def small(kind: int) -> None:
@@ -314,6 +330,8 @@ _ROLES = {
     ("send", "zenoh-loop"): lambda port: _zenoh_sender(port, f"{_SERVICE}-loop"),
     ("recv", "iceoryx2"): _iceoryx2_receiver,
     ("send", "iceoryx2"): _iceoryx2_sender,
+    ("recv", "aiorobot-iox"): lambda port: _aiorobot_receiver(port, iceoryx2=True),
+    ("send", "aiorobot-iox"): lambda port: _aiorobot_sender(port, iceoryx2=True),
 }
 
 
@@ -503,6 +521,7 @@ def table(part: dict[str, Any]) -> Any:
         "zenoh": "bare zenoh-python put -> callback",
         "zenoh-loop": "bare zenoh-python -> asyncio loop",
         "iceoryx2": "iceoryx2 pub/sub + event",
+        "aiorobot-iox": "aiorobot + iceoryx2 data path (prototype)",
     }
     for path, fig in part.get("paths", {}).items():
         if "error" in fig:
@@ -511,6 +530,10 @@ def table(part: dict[str, Any]) -> Any:
         s, i, b = fig["small"], fig["image"], fig["burst"]
         rates = b["recv_msgs_per_sec"]
         rate = f"{min(rates) / 1000:.1f}-{max(rates) / 1000:.1f}k" if rates else "-"
+        if path == "aiorobot-iox":  # its small messages and bursts go over zenoh, as aiorobot's
+            rows.append((names[path], "-", "-", i.get("p50_us", nan), i.get("p99_us", nan), "-",
+                         "-", i.get("send_call", {}).get("p50_us", nan)))
+            continue
         rows.append((
             names.get(path, path), s.get("p50_us", nan), s.get("p99_us", nan), i.get("p50_us", nan), i.get("p99_us", nan),
             f"{rate} ({100 * b['received'] / max(b['sent'], 1):.0f} % of {b['sent']})",
@@ -531,7 +554,7 @@ def table(part: dict[str, Any]) -> Any:
 if __name__ == "__main__":
     _role, _path, _port = sys.argv[1], sys.argv[2], int(sys.argv[3])
     if (_role, _path) not in _ROLES:
-        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2; found {sys.argv[1:3]}",
+        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2, aiorobot-iox; found {sys.argv[1:3]}",
               file=sys.stderr)
         sys.exit(2)
     from .. import run as _aiorun
