@@ -235,8 +235,8 @@ def _ser_string(g: _Gen, t: FieldType, expr: str, path: str) -> None:
         g.unknown(2)
 
 
-def build_serializer(cls: type) -> Callable[[Any], bytes]:
-    spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
+def _ser_gen(spec: MsgSpec) -> _Gen:
+    """A serializer's body: the CDR parts appended to ``o``, ``p`` their length after the header."""
     g = _Gen("<", "ser")
     g.emit("o = [_HDR]")
     g.emit("_ap = o.append")
@@ -245,6 +245,12 @@ def build_serializer(cls: type) -> Callable[[Any], bytes]:
     g.flush()
     g.ns["_HDR"] = HEADER_LE
     g.ns["_NUL"] = b"\x00"
+    return g
+
+
+def build_serializer(cls: type) -> Callable[[Any], bytes]:
+    spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
+    g = _ser_gen(spec)
     if not g.dynamic and g.packs == 1:
         # a fixed layout: one struct call, no list needed
         keep: list[str] = []
@@ -268,14 +274,7 @@ def build_parts_serializer(cls: type) -> Callable[[Any], tuple[list[Any], int]]:
     writer that copies them straight into a buffer it was lent (a shared-memory sample), so a
     large array is copied once instead of twice. ``b"".join(parts)`` is ``serialize(m)``."""
     spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
-    g = _Gen("<", "ser")
-    g.emit("o = [_HDR]")
-    g.emit("_ap = o.append")
-    g.emit("p = 0")
-    _ser_fields(g, spec, "m", "")
-    g.flush()
-    g.ns["_HDR"] = HEADER_LE
-    g.ns["_NUL"] = b"\x00"
+    g = _ser_gen(spec)
     src = g.source("def serialize_parts(m):", [f"return o, p + {len(HEADER_LE)}"])
     return _compile(src, g, f"<aiorobot.msgs CDR parts serializer {spec.name}>", "serialize_parts")
 
