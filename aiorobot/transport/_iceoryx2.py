@@ -74,7 +74,9 @@ def _open(service: str) -> tuple[Any, Any, Any]:
 
 
 class Iceoryx2Sender:
-    """Sends every message published on ``topic`` in this process over the iceoryx2 ``service``."""
+    """Sends every message published on ``topic`` in this process over the iceoryx2 ``service``
+    (``max_bytes``: the CDR size to expect; larger messages get larger segments). It stays on the
+    bus until :meth:`close`."""
 
     def __init__(self, transport: ZenohTransport, msg_type: Any, topic: str, service: str, *, max_bytes: int) -> None:
         import iceoryx2 as iox2
@@ -118,7 +120,11 @@ class Iceoryx2Sender:
             if not self._gid:
                 out = transport._outbound.get((self.topic, self.msg_type.__msgtype__))
                 self._gid = out._tail[1:] if out is not None else b"\0" * GID_BYTES
-            sample = self._publisher.loan_slice_uninit(GID_BYTES + size)
+            try:
+                sample = self._publisher.loan_slice_uninit(GID_BYTES + size)
+            except Exception as err:  # noqa: BLE001 - LoanError: every sample still held by subscribers
+                transport._warn("iceoryx2", f"cannot send a message on {self.topic} over iceoryx2: {type(err).__name__}: {err}")
+                return
             dst = memoryview((ctypes.c_uint8 * (GID_BYTES + size)).from_address(sample.payload_ptr)).cast("B")
             dst[:GID_BYTES] = self._gid
             pos = GID_BYTES

@@ -160,3 +160,27 @@ async def test_a_publisher_killed_with_sigkill_leaves_the_receiver_running_and_a
         finally:
             await second.stop()
         assert rt.transport.statistics().dropped == 0 and receiver._thread.is_alive()
+
+
+async def test_a_malformed_sample_is_dropped_with_one_warning_and_the_next_one_arrives(router_port: int, caplog: Any) -> None:
+    import ctypes
+
+    import iceoryx2 as iox2
+
+    service = f"aiorobot/test/{router_port}/bad"
+    async with _viewer(router_port, service) as (rt, images, receiver):
+        node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
+        data = node.service_builder(iox2.ServiceName.new(service)).publish_subscribe(iox2.Slice[ctypes.c_uint8]).open_or_create()
+        publisher = data.publisher_builder().initial_max_slice_len(1 << 16).create()
+        notifier = node.service_builder(iox2.ServiceName.new(service + "/event")).event().open_or_create().notifier_builder().create()
+        good = Image(height=4, width=4, encoding="mono8", step=4, data=np.arange(16, dtype=np.uint8))
+        for payload in (bytes(16) + b"\x07\x07\x00\x00" + bytes(40), bytes(16) + serialize(good)):
+            sample = publisher.loan_slice_uninit(len(payload))
+            ctypes.memmove(sample.payload_ptr, payload, len(payload))
+            sample.assume_init().send()
+            notifier.notify()
+        await wait_until(lambda: bool(images))
+        assert np.array_equal(images[0].data, good.data) and len(images) == 1  # from an unknown GID: delivered all the same
+        assert rt.transport.statistics().drop_reasons == {"cdr": 1}
+        assert [r.getMessage() for r in caplog.records if "iceoryx2" in r.getMessage() and "malformed CDR" in r.getMessage()]
+        assert receiver._thread.is_alive()
