@@ -12,6 +12,10 @@ Paths (each one a sender process and a receiver process of its own):
   aiorobot's included;
 - ``iceoryx2``: iceoryx2 pub/sub with an event to wake the receiver, when ``iceoryx2`` is
   importable; the image written once into a loaned sample;
+- ``aiorobot-iox``: the ``aiorobot`` pair (domain 1, apart from it) with the image topic over the
+  iceoryx2 data path prototype (``aiorobot.transport._iceoryx2``), when ``iceoryx2`` is importable;
+  its small messages and bursts go over zenoh as the ``aiorobot`` pair's do, so the table leaves
+  them out;
 - ``dora-rs``: two dora-rs Python nodes, when ``dora`` is importable: the bench starts a dora
   coordinator, daemon and dataflow of its own and its sender and receiver join it as dynamic nodes
   (:mod:`aiorobot.bench._dora`).
@@ -35,7 +39,7 @@ from typing import Any
 
 __all__ = ["PATHS", "available_paths", "run", "table"]
 
-PATHS = ("aiorobot", "zenoh", "zenoh-loop", "iceoryx2", "dora-rs")
+PATHS = ("aiorobot", "zenoh", "zenoh-loop", "iceoryx2", "aiorobot-iox", "dora-rs")
 SMALL_BYTES = 52  # a Twist's CDR
 IMAGE_BYTES = 640 * 480 * 3
 SMALL_HZ = 1000.0
@@ -49,6 +53,7 @@ def available_paths() -> dict[str, str | None]:
 
     out: dict[str, str | None] = {"aiorobot": None, "zenoh": None, "zenoh-loop": None}
     out["iceoryx2"] = None if importlib.util.find_spec("iceoryx2") else "not installed (pip install iceoryx2)"
+    out["aiorobot-iox"] = out["iceoryx2"]
     out["dora-rs"] = None if importlib.util.find_spec("dora") else "not installed (pip install dora-rs dora-rs-cli)"
     return out
 
@@ -90,14 +95,20 @@ def _unstamp(data: Any) -> tuple[int, int]:
     return data[8], int.from_bytes(bytes(data[:8]), "little")
 
 
-async def _aiorobot_receiver(port: int) -> None:
+async def _aiorobot_receiver(port: int, iceoryx2: bool = False) -> None:
+    """With ``iceoryx2``, the image over the iceoryx2 data path prototype (domain 1)."""
     from .. import Node, QoSProfile, Runtime
     from ..msgs.geometry_msgs import Twist
     from ..msgs.sensor_msgs import Image
     from ..transport import ZenohTransport
 
     rec = _Record()
-    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
+    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"])
+    async with Runtime(transport=transport, handle_signals=False) as rt:
+        if iceoryx2:
+            from ..transport._iceoryx2 import Iceoryx2Receiver
+
+            Iceoryx2Receiver(transport, Image, "/bench/image", f"{_SERVICE}/{port}/aiorobot-image")
         node = rt.add_node(Node("bench_sink"))
         node.create_subscription(Twist, "/bench/twist", lambda m: rec.got(int(m.linear.y), int(m.linear.x)), QoSProfile(depth=10))
         node.create_subscription(
@@ -107,7 +118,7 @@ async def _aiorobot_receiver(port: int) -> None:
         await _serve_stdin(lambda cmd: rec.report())
 
 
-async def _aiorobot_sender(port: int) -> None:
+async def _aiorobot_sender(port: int, iceoryx2: bool = False) -> None:
     import numpy as np
 
     from .. import Node, QoSProfile, Runtime
@@ -115,10 +126,15 @@ async def _aiorobot_sender(port: int) -> None:
     from ..msgs.sensor_msgs import Image
     from ..transport import ZenohTransport
 
-    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
+    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"])
+    async with Runtime(transport=transport, handle_signals=False) as rt:
         node = rt.add_node(Node("bench_source"))
         twist = node.create_publisher(Twist, "/bench/twist", QoSProfile(depth=10))
         image = node.create_publisher(Image, "/bench/image", QoSProfile(depth=10))
+        if iceoryx2:
+            from ..transport._iceoryx2 import Iceoryx2Sender
+
+            Iceoryx2Sender(transport, Image, "/bench/image", f"{_SERVICE}/{port}/aiorobot-image", max_bytes=IMAGE_BYTES + 1024)
         data = np.zeros(IMAGE_BYTES, dtype=np.uint8)
 
         def small(kind: int) -> None:
@@ -314,6 +330,8 @@ _ROLES = {
     ("send", "iceoryx2"): _iceoryx2_sender,
     ("recv", "dora-rs"): lambda port: _dora_role("receiver", port),
     ("send", "dora-rs"): lambda port: _dora_role("sender", port),
+    ("recv", "aiorobot-iox"): lambda port: _aiorobot_receiver(port, iceoryx2=True),
+    ("send", "aiorobot-iox"): lambda port: _aiorobot_sender(port, iceoryx2=True),
 }
 
 
@@ -530,6 +548,7 @@ def table(part: dict[str, Any]) -> Any:
         "zenoh-loop": "bare zenoh-python -> asyncio loop",
         "iceoryx2": "iceoryx2 pub/sub + event",
         "dora-rs": "dora-rs, two Python dynamic nodes",
+        "aiorobot-iox": "aiorobot + iceoryx2 data path (prototype)",
     }
     for path, fig in part.get("paths", {}).items():
         if "error" in fig:
@@ -538,6 +557,10 @@ def table(part: dict[str, Any]) -> Any:
         s, i, b = fig["small"], fig["image"], fig["burst"]
         rates = b["recv_msgs_per_sec"]
         rate = f"{min(rates) / 1000:.1f}-{max(rates) / 1000:.1f}k" if rates else "-"
+        if path == "aiorobot-iox":  # its small messages and bursts go over zenoh, as aiorobot's
+            rows.append((names[path], "-", "-", i.get("p50_us", nan), i.get("p99_us", nan), "-",
+                         "-", i.get("send_call", {}).get("p50_us", nan)))
+            continue
         rows.append((
             names.get(path, path), s.get("p50_us", nan), s.get("p99_us", nan), i.get("p50_us", nan), i.get("p99_us", nan),
             f"{rate} ({100 * b['received'] / max(b['sent'], 1):.0f} % of {b['sent']})",
@@ -558,7 +581,7 @@ def table(part: dict[str, Any]) -> Any:
 if __name__ == "__main__":
     _role, _path, _port = sys.argv[1], sys.argv[2], int(sys.argv[3])
     if (_role, _path) not in _ROLES:
-        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2, dora-rs; found {sys.argv[1:3]}",
+        print(f"expected ROLE PATH PORT with ROLE recv|send and PATH one of aiorobot, zenoh, zenoh-loop, iceoryx2, aiorobot-iox, dora-rs; found {sys.argv[1:3]}",
               file=sys.stderr)
         sys.exit(2)
     from .. import run as _aiorun

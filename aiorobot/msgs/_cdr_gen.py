@@ -19,7 +19,7 @@ from ._classgen import FrozenList, as_array, as_fixed_array, dtype_of
 from ._registry import get
 from ._spec import ARRAY, PRIMITIVES, SCALAR, SEQUENCE, FieldType, MsgSpec
 
-__all__ = ["build_deserializer", "build_serializer", "fmt_path", "generated_source", "where"]
+__all__ = ["build_deserializer", "build_parts_serializer", "build_serializer", "fmt_path", "generated_source", "where"]
 
 HEADER_LE = b"\x00\x01\x00\x00"
 _PAD = tuple(b"\x00" * i for i in range(8))
@@ -235,8 +235,8 @@ def _ser_string(g: _Gen, t: FieldType, expr: str, path: str) -> None:
         g.unknown(2)
 
 
-def build_serializer(cls: type) -> Callable[[Any], bytes]:
-    spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
+def _ser_gen(spec: MsgSpec) -> _Gen:
+    """A serializer's body: the CDR parts appended to ``o``, ``p`` their length after the header."""
     g = _Gen("<", "ser")
     g.emit("o = [_HDR]")
     g.emit("_ap = o.append")
@@ -245,6 +245,12 @@ def build_serializer(cls: type) -> Callable[[Any], bytes]:
     g.flush()
     g.ns["_HDR"] = HEADER_LE
     g.ns["_NUL"] = b"\x00"
+    return g
+
+
+def build_serializer(cls: type) -> Callable[[Any], bytes]:
+    spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
+    g = _ser_gen(spec)
     if not g.dynamic and g.packs == 1:
         # a fixed layout: one struct call, no list needed
         keep: list[str] = []
@@ -260,6 +266,17 @@ def build_serializer(cls: type) -> Callable[[Any], bytes]:
     else:
         src = g.source("def serialize(m):", ["return b''.join(o)"])
     return _compile(src, g, f"<aiorobot.msgs CDR serializer {spec.name}>", "serialize")
+
+
+def build_parts_serializer(cls: type) -> Callable[[Any], tuple[list[Any], int]]:
+    """The serializer of ``cls`` stopping short of the join: ``(parts, size)``, the CDR as a list
+    of buffers (bytes, and memoryviews of the message's arrays) and their total length, for a
+    writer that copies them straight into a buffer it was lent (a shared-memory sample), so a
+    large array is copied once instead of twice. ``b"".join(parts)`` is ``serialize(m)``."""
+    spec: MsgSpec = cls._spec  # type: ignore[attr-defined]
+    g = _ser_gen(spec)
+    src = g.source("def serialize_parts(m):", [f"return o, p + {len(HEADER_LE)}"])
+    return _compile(src, g, f"<aiorobot.msgs CDR parts serializer {spec.name}>", "serialize_parts")
 
 
 # -------------------------------------------------------------- deserializer
