@@ -36,7 +36,7 @@ from ..msgs import deserialize as _deserialize
 from ..msgs._cdr_gen import build_parts_serializer
 from ._zenoh import _ANY_QOS, ZenohTransport, _Inbound
 
-__all__ = ["BORROW_MAX", "BUFFER_SIZE", "Iceoryx2Receiver", "Iceoryx2Sender", "unavailable"]
+__all__ = ["BORROW_MAX", "BUFFER_SIZE", "INITIAL_BYTES", "Iceoryx2Receiver", "Iceoryx2Sender", "unavailable"]
 
 GID_BYTES = 16
 #: samples a subscriber holds queued (its buffer) and holds for messages still alive (borrowed)
@@ -44,6 +44,9 @@ BUFFER_SIZE = 8
 BORROW_MAX = 8
 #: how long the receiving thread waits for an event before it looks whether it should stop
 WAIT_MS = 100
+#: a sender's first slice length when ZenohTransport(iceoryx2_topics=) makes it; larger messages
+#: get larger segments (iceoryx2's power-of-two allocation)
+INITIAL_BYTES = 64 * 1024
 _SERIALIZERS: dict[type, Any] = {}
 
 

@@ -47,6 +47,7 @@ from ..msgs import serialize as _serialize
 from ._diagnose import NOTHING_LISTENS, host_port, why_unreachable
 from ._session_config import (
     SessionPlan,
+    ZenohConfigError,
     ZenohSessionError,
     allowed_plain,
     apply_overrides,
@@ -595,6 +596,14 @@ class ZenohTransport(Transport):
         a message whose CDR is ``shm_threshold`` bytes or more (``ZENOH_SHM_MESSAGE_SIZE_THRESHOLD``,
         2 KiB) is put from a shared-memory pool (``ZENOH_SHM_ALLOC_SIZE``, 48 MiB), as
         rmw_zenoh does: a peer on this host maps it instead of receiving it over the socket.
+    iceoryx2_topics
+        Topics whose data goes over iceoryx2's shared memory between aiorobot processes on this
+        host, serialised straight into a loaned sample (one copy of an image end to end, against
+        three over zenoh); discovery, the graph and every other topic stay on zenoh. Every process
+        of such a topic must list it (``AIOROBOT_ICEORYX2_TOPICS=/a,/b`` when this is None): its
+        subscriptions here then receive only over iceoryx2 (not from other hosts or rmw_zenoh
+        nodes), while its publishers still reach zenoh subscribers too. Needs ``iceoryx2``
+        (``pip install iceoryx2``). See docs/zenoh.md.
     """
 
     name = "zenoh"
@@ -608,9 +617,14 @@ class ZenohTransport(Transport):
         listen: list[str] | None = None,
         shared_memory: bool | None = None,
         allow_plain: list[str] | tuple[str, ...] = (),
+        iceoryx2_topics: list[str] | tuple[str, ...] | None = None,
     ) -> None:
         super().__init__(domain_id=domain_id)
         self.allow_plain = tuple(allow_plain)
+        if iceoryx2_topics is None:
+            iceoryx2_topics = os.environ.get("AIOROBOT_ICEORYX2_TOPICS", "").split(",")
+        self.iceoryx2_topics = frozenset("/" + t.strip().strip("/") for t in iceoryx2_topics if t.strip().strip("/"))
+        self._iox_senders: dict[tuple[str, str], Any] = {}
         self._connect_failures = 0
         self.config_file = config_file
         self.connect = connect
@@ -670,6 +684,15 @@ class ZenohTransport(Transport):
         import zenoh
 
         cfg, plan = self._config()  # a bad config or certificate path: ZenohConfigError, nothing opened
+        if self.iceoryx2_topics:
+            from ._iceoryx2 import unavailable
+
+            why = unavailable()
+            if why is not None:
+                raise ZenohConfigError(
+                    "ZenohTransport(iceoryx2_topics=) / AIOROBOT_ICEORYX2_TOPICS", None,
+                    f"{', '.join(sorted(self.iceoryx2_topics))} over iceoryx2: expected the iceoryx2 package, found none ({why})",
+                )
         await super().open(bus)
         self._loop = asyncio.get_running_loop()
         self._owner = _Owner(self._loop, threading.get_ident(), "<zenoh>")
@@ -731,6 +754,9 @@ class ZenohTransport(Transport):
                 if bus is not None:
                     bus.remove(out.tap)
                 out.close()
+            for sender in self._iox_senders.values():
+                sender.close()
+            self._iox_senders.clear()
             for inb in self._inbound.values():
                 if bus is not None:
                     bus.remove(inb.fallback)
@@ -849,6 +875,10 @@ class ZenohTransport(Transport):
             inbox = self._inboxes[loop] = _Inbox(self, loop)
         return inbox
 
+    def _iceoryx2_service(self, topic: str, type_hash: str) -> str:
+        """The iceoryx2 service of ``topic`` in this domain (every process on the host derives it)."""
+        return f"aiorobot/{self.domain_id}/{topic.strip('/')}/{type_hash}"
+
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)
         if cached is None:
@@ -927,6 +957,9 @@ class ZenohTransport(Transport):
                         if self.bus is not None:
                             self.bus.remove(out.tap)
                         out.close()
+                        sender = self._iox_senders.pop((out.topic, endpoint.type_name), None)
+                        if sender is not None:
+                            sender.close()
             elif isinstance(endpoint, (Subscription, Tap)):
                 inb = self._inbound.get((endpoint.topic_name, endpoint.type_name))
                 if inb is not None and endpoint in inb.subscriptions:
@@ -954,13 +987,25 @@ class ZenohTransport(Transport):
         out.publishers.append(pub)
         if new and self.bus is not None:
             self.bus.add_subscription(out.tap)
+            if pub.topic_name in self.iceoryx2_topics:
+                from ._iceoryx2 import INITIAL_BYTES, Iceoryx2Sender
+
+                self._iox_senders[key] = Iceoryx2Sender(
+                    self, pub.msg_type, pub.topic_name, self._iceoryx2_service(pub.topic_name, type_hash),
+                    max_bytes=INITIAL_BYTES,
+                )
 
     def _add_subscription(self, sub: Subscription[Any]) -> None:
         type_hash = self._hash(sub.msg_type)
         key = (sub.topic_name, sub.type_name)
         inb = self._inbound.get(key)
         new = inb is None
-        if inb is None:
+        if inb is None and sub.topic_name in self.iceoryx2_topics:
+            from ._iceoryx2 import Iceoryx2Receiver  # (it takes its place in _inbound, fallback added)
+
+            inb = Iceoryx2Receiver(self, sub.msg_type, sub.topic_name, self._iceoryx2_service(sub.topic_name, type_hash))
+            new = False
+        elif inb is None:
             inb = self._inbound[key] = _Inbound(self, sub.topic_name, sub.msg_type, type_hash)
         inb.add(sub)
         if new and self.bus is not None:

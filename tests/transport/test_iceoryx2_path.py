@@ -184,3 +184,62 @@ async def test_a_malformed_sample_is_dropped_with_one_warning_and_the_next_one_a
         assert rt.transport.statistics().drop_reasons == {"cdr": 1}
         assert [r.getMessage() for r in caplog.records if "iceoryx2" in r.getMessage() and "malformed CDR" in r.getMessage()]
         assert receiver._thread.is_alive()
+
+
+PLAIN_CAMERA = """
+import numpy as np
+from aiorobot.msgs.sensor_msgs import Image
+async def main(rt):
+    node = Node("camera")
+    rt.add_node(node)
+    pub = node.create_publisher(Image, TOPIC, 10)
+    say("ready")
+    reader = await stdin_lines()
+    while line := (await reader.readline()).decode().strip():
+        first, count = map(int, line.split())
+        for i in range(first, first + count):
+            pixels = np.random.default_rng(i).integers(0, 256, 320 * 240 * 3, dtype=np.uint8)
+            msg = Image(height=240, width=320, encoding="rgb8", step=960, data=pixels)
+            msg.header.frame_id = str(i)
+            pub.publish(msg)
+        say("sent", rt.transport._iox_senders[(TOPIC, "sensor_msgs/msg/Image")].sent, rt.transport.statistics().sent)
+"""
+
+
+async def test_a_topic_listed_in_iceoryx2_topics_goes_over_iceoryx2_between_plain_publishers_and_subscriptions(
+    router_port: int, monkeypatch: Any
+) -> None:
+    """ZenohTransport(iceoryx2_topics=) / AIOROBOT_ICEORYX2_TOPICS: plain create_publisher and
+    create_subscription in two processes; the service is agreed from domain, topic and type."""
+    from aiorobot.transport._iceoryx2 import Iceoryx2Receiver
+
+    topic = f"/image_{router_port}"  # (iceoryx2 services are host-wide: one per test run)
+    monkeypatch.setenv("AIOROBOT_ICEORYX2_TOPICS", f"/other, {topic}")  # the child reads it too
+    child = await spawn(f"TOPIC = {topic!r}\n" + PLAIN_CAMERA, router_port)
+    try:
+        await child.expect("ready")
+        transport = ZenohTransport(connect=[f"tcp/127.0.0.1:{router_port}"])
+        assert transport.iceoryx2_topics == {"/other", topic}
+        async with Runtime(transport=transport, handle_signals=False) as rt:
+            images: list[Image] = []
+            rt.add_node(Node("viewer")).create_subscription(Image, topic, images.append, 10)
+            assert isinstance(transport._inbound[(topic, "sensor_msgs/msg/Image")], Iceoryx2Receiver)
+            await wait_until(lambda: len(rt.graph.publishers_of(topic)) == 1)
+            child.send("0 5")
+            sent, over_zenoh = map(int, (await child.expect("sent")).split()[1:])
+            await wait_until(lambda: len(images) >= 5)
+            assert sent == 5 and over_zenoh == 0  # each image once, over iceoryx2
+            _check(images, 0)
+            assert getattr(_root(images[0].data), "_sample", None) is not None
+    finally:
+        await child.stop()
+
+
+async def test_iceoryx2_topics_without_iceoryx2_is_one_config_error_before_anything_opens(monkeypatch: Any) -> None:
+    from aiorobot._core._errors import ConfigError
+    from aiorobot.transport import _iceoryx2
+
+    monkeypatch.setattr(_iceoryx2, "unavailable", lambda: "iceoryx2 is not installed (pip install iceoryx2)")
+    with pytest.raises(ConfigError, match=r"/cam over iceoryx2: expected the iceoryx2 package, found none \(iceoryx2 is not"):
+        async with Runtime(transport=ZenohTransport(iceoryx2_topics=["cam"]), handle_signals=False):
+            pass
