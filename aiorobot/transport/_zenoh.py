@@ -87,6 +87,9 @@ QUERY_TIMEOUT_SEC = 24 * 3600.0
 WARN_INTERVAL_SEC = 1.0
 #: How long a remote node has to describe a type this process does not know (``~/get_type_description``).
 DESCRIBE_TIMEOUT_SEC = 5.0
+#: Queries for one type that a node serving get_type_description left unanswered (its queryable's
+#: route not up yet): asked again 0.05 s later, doubling up to 2 s, this many times in all.
+DESCRIBE_ATTEMPTS = 8
 #: rmw_zenoh's defaults: a 48 MiB shared-memory pool per session, used for messages of 2 KiB and more
 #: (``ZENOH_SHM_ALLOC_SIZE`` and ``ZENOH_SHM_MESSAGE_SIZE_THRESHOLD`` change them, in bytes)
 SHM_ALLOC_SIZE = 48 * 1024 * 1024
@@ -1273,13 +1276,23 @@ class ZenohTransport(Transport):
                 self._remote[token] = None
                 if payload is None:  # no get_type_description at that node (yet): ask when it appears
                     self._undescribed.setdefault(info.node_fqn, []).append(info)
-                    if info.node_fqn in self._describers and self._asks[key] < 3:
-                        self._describe_again(info.node_fqn)  # it appeared while the query was on its way
+                    asks = self._asks[key]
+                    if info.node_fqn in self._describers and asks < DESCRIBE_ATTEMPTS and self._loop is not None:
+                        # it appeared while the query was on its way, or its queryable's route is not
+                        # up yet (its liveliness token came first): ask again, backing off
+                        self._loop.call_later(
+                            min(0.05 * 2**asks, 2.0), self._describe_again_if_open, info.node_fqn
+                        )
                 elif ok:
                     try:
                         self._learn(info)
                     except Exception as err:  # noqa: BLE001 - a bad peer must not break discovery
                         self._warn("token", f"could not add remote {info.kind} {info.topic}: {err}")
+
+    def _describe_again_if_open(self, node: str) -> None:
+        if self.bus is not None and self._session is not None:
+            with self._lock:
+                self._describe_again(node)
 
     def _describe_again(self, node: str) -> None:
         """``node``'s ``get_type_description`` appeared: ask it about the types it could not describe before."""
