@@ -66,6 +66,7 @@ class Context:
         self._local = threading.local()
         self._on_shutdown: list[Callable[[], Any]] = []
         self._saved_handlers: dict[int, Any] = {}
+        self._saved_unraisablehook: Any = None
         #: Ctrl-C arrived while the loop ran in this thread: the spin raises KeyboardInterrupt on its way out
         self._interrupted = False
         #: spin loops (rclpy.spin, Executor.spin) running in the main thread: Ctrl-C between two
@@ -478,6 +479,23 @@ class Context:
                 self._saved_handlers[sig] = signal.signal(sig, handler)
             except (ValueError, OSError):  # pragma: no cover
                 pass
+        previous_hook = self._saved_unraisablehook = sys.unraisablehook
+
+        def redeliver_swallowed_interrupt(unraisable: Any) -> None:
+            # Python runs a signal handler wherever the main thread is, a finaliser or a weakref
+            # callback included (a WeakSet's, during garbage collection). An exception raised there is
+            # printed as "Exception ignored in ..." and dropped, so the program would miss its Ctrl-C.
+            # Deliver it again: the handler runs once more at the main thread's next instruction.
+            tb = unraisable.exc_traceback
+            while tb is not None and tb.tb_next is not None:
+                tb = tb.tb_next
+            if unraisable.exc_type is KeyboardInterrupt and tb is not None and tb.tb_frame.f_code is on_sigint.__code__:
+                threading.Thread(target=_signal_main_thread_after, args=(sys._getframe(),), daemon=True,
+                                 name="aiorobot-redeliver-sigint").start()
+                return
+            previous_hook(unraisable)
+
+        sys.unraisablehook = redeliver_swallowed_interrupt
 
     def _restore_signal_handlers(self) -> None:
         if threading.current_thread() is not threading.main_thread():
@@ -485,6 +503,28 @@ class Context:
         for sig, previous in self._saved_handlers.items():
             signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
         self._saved_handlers.clear()
+        if self._saved_unraisablehook is not None:
+            sys.unraisablehook, self._saved_unraisablehook = self._saved_unraisablehook, None
+
+
+def _signal_main_thread_after(hook_frame: Any) -> None:
+    """SIGINT to the main thread once it has left ``hook_frame`` (sys.unraisablehook's).
+
+    Signalled while the hook still runs, the handler would raise in the hook, where the exception
+    is dropped again; a real signal (not ``_thread.interrupt_main``) also ends a ``time.sleep``.
+    """
+    main = threading.main_thread().ident
+    assert main is not None
+    deadline, frame = time.monotonic() + 5.0, None
+    while time.monotonic() < deadline:
+        frame = sys._current_frames().get(main)
+        while frame is not None and frame is not hook_frame:
+            frame = frame.f_back
+        if frame is None:
+            break
+        time.sleep(0.0005)
+    del hook_frame, frame
+    signal.pthread_kill(main, signal.SIGINT)
 
 
 def _at_exit(ref: weakref.ref[Context]) -> None:

@@ -168,3 +168,30 @@ def test_a_program_ending_without_shutdown_exits_on_every_transport(router, tmp_
         )
         assert program.finish() == 0, (transport, program.output)
         assert "main ends" in program.output, (transport, program.output)
+
+
+def test_a_ctrl_c_landing_in_a_weakref_callback_still_reaches_the_program(tmp_path: Path):
+    # Python runs the SIGINT handler wherever the main thread is; in a weakref callback (a WeakSet's,
+    # during garbage collection) the KeyboardInterrupt would be printed as "Exception ignored" and lost.
+    script = tmp_path / "interrupted_in_a_finaliser.py"
+    script.write_text(textwrap.dedent("""
+        import signal, time, weakref
+        import rclpy
+
+        class Thing:
+            pass
+
+        rclpy.init()
+        thing = Thing()
+        ref = weakref.ref(thing, lambda _: signal.raise_signal(signal.SIGINT))
+        try:
+            del thing  # the callback runs, and the handler with it, inside the callback
+            time.sleep(60)
+            print('the Ctrl-C was lost', flush=True)
+        except KeyboardInterrupt:
+            print('interrupted, ok =', rclpy.ok(), flush=True)
+    """))
+    program = Program(str(script), exec_args=("--transport", "local"))
+    assert program.finish() == 0, program.output
+    assert "interrupted, ok = False" in program.output, program.output
+    assert "Exception ignored" not in program.output and "Traceback" not in program.output, program.output
