@@ -260,7 +260,7 @@ class _Inbound:
         """On a Cyclone thread: take, check and decode, then hand over to the loop the topic's
         subscriptions run on (the priority loop's when one runs there, else the main loop)."""
         transport = self.transport
-        from ..msgs import DeserializationError, deserialize
+        from ..msgs import deserialize
 
         loop = delivery_loop(self.subscriptions, transport._loop)  # the priority loop's, if one subscribes
         for data, info in transport._take(reader):
@@ -272,11 +272,8 @@ class _Inbound:
                 continue
             try:
                 msg = deserialize(data, self.msg_type)
-            except DeserializationError as err:
-                transport._warn("cdr", f"dropped a sample on rt{self.topic}: malformed CDR: {err}")
-                continue
             except Exception as err:  # noqa: BLE001 - nothing from the network may escape
-                transport._warn("other", f"dropped a sample on rt{self.topic}: {type(err).__name__}: {err}")
+                transport._drop_sample(f"rt{self.topic}", err)
                 continue
             transport._received += 1
             if loop is not None:
@@ -576,6 +573,7 @@ class DdsTransport(Transport):
     # cached type hashes; a received message published into the bus by its remote publisher's
     # injector (``_by_gid``: here keyed by the DDS publication handle); a remote endpoint joined to it.
     _warn = ZenohTransport._warn
+    _drop_sample = ZenohTransport._drop_sample
     _to_loop = ZenohTransport._to_loop
     _hash = ZenohTransport._hash
     _add_to_bus = ZenohTransport._add_to_bus

@@ -222,11 +222,8 @@ class Iceoryx2Receiver(_Inbound):
                 data = bytes(memoryview(buf).cast("B")[GID_BYTES:])
                 self.copied += 1
             msg = _deserialize(data, self.msg_type, view=True)
-        except _DeserializationError as err:
-            transport._warn("cdr", f"dropped a sample on {self.topic} (iceoryx2): malformed CDR: {err}")
-            return None
         except Exception as err:  # noqa: BLE001 - nothing from another process may escape
-            transport._warn("other", f"dropped a sample on {self.topic} (iceoryx2): {type(err).__name__}: {err}")
+            transport._drop_sample(f"{self.topic} (iceoryx2)", err)
             return None
         transport._received += 1
         return gid, msg

@@ -451,14 +451,8 @@ class _Inbound:
             msg = _deserialize(data, self.msg_type, view=True)  # arrays: read-only views into the bytes
             if len(data) >= SHM_MIN_CHECK and payload.as_shm() is not None:
                 transport._received_shm += 1
-        except WireError as err:
-            transport._warn("wire", f"dropped a sample on {key}: {err}")
-            return None
-        except _DeserializationError as err:
-            transport._warn("cdr", f"dropped a sample on {key}: malformed CDR: {err}")
-            return None
         except Exception as err:  # noqa: BLE001 - nothing from the network may escape
-            transport._warn("other", f"dropped a sample on {key}: {type(err).__name__}: {err}")
+            transport._drop_sample(key, err)
             return None
         transport._received += 1
         return gid, msg
@@ -507,6 +501,7 @@ class _Inbox:
     def __init__(self, transport: ZenohTransport, loop: asyncio.AbstractEventLoop | None) -> None:
         self.transport = transport
         self._fixed_loop = loop  # None: the transport's (main) loop, known once it opens
+        self.loop_name = "main" if loop is None else "priority"
         self.pending: deque[tuple[_Inbound, Any]] = deque()
         self.armed = False  # a drain is due on the loop
         self._arming = threading.Lock()
@@ -521,9 +516,7 @@ class _Inbox:
         if len(pending) >= BACKLOG_LIMIT:
             lost, _ = pending.popleft()
             self.transport._warn(
-                "backlog", f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the main loop"
-                if self._fixed_loop is None else
-                f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the priority loop"
+                "backlog", f"dropped the oldest sample on {lost.topic}: {BACKLOG_LIMIT} were waiting for the {self.loop_name} loop"
             )
         pending.append((inbound, decoded))
         if not self.armed:  # (a drain woken before the decoding ran meanwhile and found nothing)
@@ -850,6 +843,15 @@ class ZenohTransport(Transport):
         if now - self._last_warning.get(reason, -1e9) >= WARN_INTERVAL_SEC:
             self._last_warning[reason] = now
             _log.warning(f"{text} ({self._drops[reason]} dropped so far for this reason)")
+
+    def _drop_sample(self, where: str, err: Exception) -> None:
+        """Say why a received sample on ``where`` (a key or a topic) was dropped, counted by reason."""
+        if isinstance(err, WireError):
+            self._warn("wire", f"dropped a sample on {where}: {err}")
+        elif isinstance(err, _DeserializationError):
+            self._warn("cdr", f"dropped a sample on {where}: malformed CDR: {err}")
+        else:
+            self._warn("other", f"dropped a sample on {where}: {type(err).__name__}: {err}")
 
     def _to_loop(self, fn: Any, *args: Any) -> None:
         if self._loop is not None:
