@@ -25,6 +25,7 @@ from ._helpers import Child, spawn, wait_until
 
 pytestmark = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
 
+# TOPIC, and SERVICE: an explicit sender on that service, or None: the transport's own (iceoryx2_topics)
 CAMERA = """
 import numpy as np
 from aiorobot.msgs.sensor_msgs import Image
@@ -32,8 +33,8 @@ from aiorobot.transport._iceoryx2 import Iceoryx2Sender
 async def main(rt):
     node = Node("camera")
     rt.add_node(node)
-    pub = node.create_publisher(Image, "/image", 10)
-    sender = Iceoryx2Sender(rt.transport, Image, "/image", SERVICE, max_bytes=320 * 240 * 3 + 1024)
+    pub = node.create_publisher(Image, TOPIC, 10)
+    sender = SERVICE and Iceoryx2Sender(rt.transport, Image, TOPIC, SERVICE, max_bytes=320 * 240 * 3 + 1024)
     say("ready")
     reader = await stdin_lines()
     while line := (await reader.readline()).decode().strip():
@@ -43,7 +44,8 @@ async def main(rt):
             msg = Image(height=240, width=320, encoding="rgb8", step=960, data=pixels)
             msg.header.frame_id = str(i)
             pub.publish(msg)
-        say("sent", sender.sent, rt.transport.statistics().sent)
+        sent = (sender or rt.transport._iox_senders[(TOPIC, "sensor_msgs/msg/Image")]).sent
+        say("sent", sent, rt.transport.statistics().sent)
 """
 
 
@@ -67,7 +69,7 @@ def _walk(folder: str) -> list[str]:
 
 
 async def _camera(port: int, service: str) -> Child:
-    child = await spawn(f"SERVICE = {service!r}\n" + CAMERA, port)
+    child = await spawn(f"TOPIC = '/image'\nSERVICE = {service!r}\n" + CAMERA, port)
     await child.expect("ready")
     return child
 
@@ -186,26 +188,6 @@ async def test_a_malformed_sample_is_dropped_with_one_warning_and_the_next_one_a
         assert receiver._thread.is_alive()
 
 
-PLAIN_CAMERA = """
-import numpy as np
-from aiorobot.msgs.sensor_msgs import Image
-async def main(rt):
-    node = Node("camera")
-    rt.add_node(node)
-    pub = node.create_publisher(Image, TOPIC, 10)
-    say("ready")
-    reader = await stdin_lines()
-    while line := (await reader.readline()).decode().strip():
-        first, count = map(int, line.split())
-        for i in range(first, first + count):
-            pixels = np.random.default_rng(i).integers(0, 256, 320 * 240 * 3, dtype=np.uint8)
-            msg = Image(height=240, width=320, encoding="rgb8", step=960, data=pixels)
-            msg.header.frame_id = str(i)
-            pub.publish(msg)
-        say("sent", rt.transport._iox_senders[(TOPIC, "sensor_msgs/msg/Image")].sent, rt.transport.statistics().sent)
-"""
-
-
 async def test_a_topic_listed_in_iceoryx2_topics_goes_over_iceoryx2_between_plain_publishers_and_subscriptions(
     router_port: int, monkeypatch: Any
 ) -> None:
@@ -215,7 +197,7 @@ async def test_a_topic_listed_in_iceoryx2_topics_goes_over_iceoryx2_between_plai
 
     topic = f"/image_{router_port}"  # (iceoryx2 services are host-wide: one per test run)
     monkeypatch.setenv("AIOROBOT_ICEORYX2_TOPICS", f"/other, {topic}")  # the child reads it too
-    child = await spawn(f"TOPIC = {topic!r}\n" + PLAIN_CAMERA, router_port)
+    child = await spawn(f"TOPIC = {topic!r}\nSERVICE = None\n" + CAMERA, router_port)
     try:
         await child.expect("ready")
         transport = ZenohTransport(connect=[f"tcp/127.0.0.1:{router_port}"])
