@@ -249,14 +249,14 @@ async def sender(daemon_port: int) -> None:
     pixels = np.zeros(IMAGE_BYTES, dtype=np.uint8)
     image = pa.array(pixels)  # over the numpy buffer: the stamp written in place is in it
 
-    def small(kind: int) -> None:
-        node.send_output("small", _stamp_bytes(kind, SMALL_BYTES))
-
-    def picture() -> None:
+    def picture() -> Any:
         pixels[:9] = np.frombuffer(time.monotonic_ns().to_bytes(8, "little") + b"\x02", dtype=np.uint8)
-        node.send_output("image", image)
+        return image
 
-    await _serve_stdin(_sender_commands(small, picture))
+    await _serve_stdin(_sender_commands(
+        (lambda kind: _stamp_bytes(kind, SMALL_BYTES), lambda data: node.send_output("small", data)),
+        (picture, lambda data: node.send_output("image", data)),
+    ))
 
 
 async def _joined(joined: concurrent.futures.Future[None], node_id: str, daemon_port: int) -> str | None:
