@@ -34,6 +34,7 @@ import json
 import socket
 import subprocess
 import sys
+import threading
 import time
 from typing import Any
 
@@ -62,29 +63,34 @@ def available_paths() -> dict[str, str | None]:
 
 
 class _Record:
-    """What a receiver saw since its last report."""
+    """What a receiver saw since its last report. ``got`` may run on a receiving thread (bare
+    zenoh's callback, iceoryx2's and dora's pumps) while ``report`` runs on the loop: both hold
+    the lock, so no message lands between a report and the reset that follows it."""
 
     def __init__(self) -> None:
-        self.reset()
+        self._lock = threading.Lock()
+        self.lat, self.burst = self._fresh()
 
-    def reset(self) -> None:
-        self.lat: dict[str, list[int]] = {"small": [], "image": []}
-        self.burst = {"n": 0, "first": 0, "last": 0}
+    @staticmethod
+    def _fresh() -> tuple[dict[str, list[int]], dict[str, int]]:
+        return {"small": [], "image": []}, {"n": 0, "first": 0, "last": 0}
 
     def got(self, kind: int, stamp: int) -> None:
         now = time.monotonic_ns()
-        if kind == 1:
-            b = self.burst
-            b["n"] += 1
-            b["first"] = b["first"] or now
-            b["last"] = now
-        else:
-            self.lat["small" if kind == 0 else "image"].append(now - stamp)
+        with self._lock:
+            if kind == 1:
+                b = self.burst
+                b["n"] += 1
+                b["first"] = b["first"] or now
+                b["last"] = now
+            else:
+                self.lat["small" if kind == 0 else "image"].append(now - stamp)
 
     def report(self) -> str:
-        line = json.dumps({"lat": self.lat, "burst": self.burst})
-        self.reset()
-        return line
+        with self._lock:
+            lat, burst = self.lat, self.burst
+            self.lat, self.burst = self._fresh()
+        return json.dumps({"lat": lat, "burst": burst})
 
 
 def _stamp_bytes(kind: int, size: int) -> bytes:
