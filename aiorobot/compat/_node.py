@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import copy
 import functools
 import inspect
@@ -74,19 +75,26 @@ class Client(_services.Client):
 class Rate:
     """rclpy's ``Rate``: ``sleep()`` blocks the calling thread until the next period (absolute grid).
 
-    As rclpy's, ``Node.destroy_rate`` wakes a thread sleeping on it (its ``sleep()`` returns),
-    a later ``sleep()`` raises ``RuntimeError``, and shutting the context down wakes a
-    sleeper with ``ROSInterruptException``.
+    As rclpy's, it runs on the node's clock unless given another, so under ``use_sim_time`` it
+    follows ``/clock`` (sim time moves only while some thread spins, as with rclpy, whose Rate
+    is a timer); ``Node.destroy_rate`` wakes a thread sleeping on it (its ``sleep()`` returns),
+    a later ``sleep()`` raises ``RuntimeError``, and shutting the context down wakes a sleeper
+    with ``ROSInterruptException``.
     """
 
-    def __init__(self, frequency: float, context: Context | None = None) -> None:
+    def __init__(self, frequency: float, context: Context | None = None, clock: Any = None) -> None:
         if isinstance(frequency, bool) or not isinstance(frequency, (int, float)) or frequency <= 0:
             raise ValueError(f"Rate: expected a frequency in Hz > 0, found {frequency!r}")
         self._period = 1.0 / frequency
+        self._period_ns = round(1e9 / frequency)
         self._next = time.monotonic() + self._period
+        self._clock = clock
+        self._context = context
+        self._next_sim: int | None = None  # the sim-time grid, started at the first sleep on sim time
         self._destroyed = False
         self._is_shutdown = False
         self._event = threading.Event()
+        self._sleepers: set[threading.Event] = set()
         if context is not None:
             context.on_shutdown(self._on_shutdown)
 
@@ -95,25 +103,80 @@ class Rate:
         self.destroy()
 
     def sleep(self) -> None:
+        """Block the calling thread until the next period on the rate's clock.
+
+        rclpy difference: on wall time it needs no thread spinning (rclpy's Rate is a timer,
+        which fires only while an executor spins); on sim time, called in a callback of a spin
+        in the same thread, it raises ``RuntimeError`` where rclpy's blocks that thread for ever
+        (the ``/clock`` that would wake it cannot be taken while it sleeps).
+        """
         from .rclpy.exceptions import ROSInterruptException
 
         if self._is_shutdown:
             raise ROSInterruptException()
         if self._destroyed:
             raise RuntimeError("Rate cannot sleep because it has been destroyed")
-        now = time.monotonic()
-        if now >= self._next + self._period:
-            self._next = now + self._period
-        delay = self._next - now
-        self._next += self._period
-        if delay > 0:
-            self._event.wait(delay)
+        clock = self._clock
+        if clock is not None and clock.use_sim_time:
+            self._sleep_sim(clock)
+        else:
+            now = time.monotonic()
+            if now >= self._next + self._period:
+                self._next = now + self._period
+            delay = self._next - now
+            self._next += self._period
+            if delay > 0:
+                self._event.wait(delay)
         if self._is_shutdown:
             raise ROSInterruptException()
+
+    def _sleep_sim(self, clock: Any) -> None:
+        """Until sim time reaches the next period: a waiter on the clock, registered on the loop."""
+        now = clock.now_ns()
+        if self._next_sim is None or now >= self._next_sim + self._period_ns:
+            self._next_sim = now + self._period_ns  # first sleep, or fell behind: restart the grid
+        deadline = self._next_sim
+        self._next_sim += self._period_ns
+        if now >= deadline:
+            return
+        loop = self._context.loop if self._context is not None else None
+        if loop is None or loop.is_closed():
+            return
+        if asyncio._get_running_loop() is loop:  # a callback of a spin on this thread
+            raise RuntimeError(
+                "Rate.sleep on sim time in a callback of a single-threaded spin would never wake: "
+                "the loop that moves sim time (/clock) is blocked in it; sleep in another thread"
+            )
+        woken = threading.Event()
+        waiting: list[asyncio.Future[None]] = []
+
+        def register() -> None:
+            fut = loop.create_future()
+            fut.add_done_callback(lambda f: (f.cancelled() or f.exception(), woken.set()))
+            waiting.append(fut)
+            try:
+                clock.add_waiter(deadline, fut)
+            except RuntimeError:  # ROS time was switched off meanwhile
+                woken.set()
+
+        self._sleepers.add(woken)
+        try:
+            if self._destroyed:
+                return
+            loop.call_soon_threadsafe(register)
+            woken.wait()
+        finally:
+            self._sleepers.discard(woken)
+            if not loop.is_closed():
+                loop.call_soon_threadsafe(lambda: [f.cancel() for f in waiting])
+        if waiting and waiting[0].done() and not waiting[0].cancelled() and waiting[0].exception() is not None:
+            self._next_sim = None  # sim time jumped back (ClockJump): the grid restarts on the new time
 
     def destroy(self) -> None:
         self._destroyed = True
         self._event.set()
+        for woken in list(self._sleepers):
+            woken.set()
 
 
 class NodeMixin:
@@ -239,7 +302,7 @@ class NodeMixin:
     def create_rate(self, frequency: float, clock: Any = None) -> Rate:  # type: ignore[override]
         if isinstance(frequency, bool) or not isinstance(frequency, (int, float)):
             raise TypeError(f"create_rate: expected a frequency in Hz (a number), found {frequency!r}")
-        rate = Rate(frequency, self._context)
+        rate = Rate(frequency, self._context, clock if clock is not None else self.get_clock())
         self._rates_list().append(rate)
         return rate
 

@@ -173,3 +173,55 @@ async def test_destroy_rate_wakes_a_task_sleeping_on_it():
             assert node.destroy_rate(rate) is False
             with pytest.raises(RuntimeError, match="destroyed"):
                 await rate.sleep()
+
+
+def _wait(predicate, what: str) -> None:
+    import time
+
+    deadline = time.monotonic() + 10  # a generous bound on what a spinning thread does at once
+    while not predicate():
+        assert time.monotonic() < deadline, what
+        time.sleep(0.001)
+
+
+def test_a_rate_follows_sim_time_under_use_sim_time():
+    # rclpy's Node.create_rate makes a timer on the node's clock: under use_sim_time, /clock paces it
+    from aiorobot.compat.rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+    from aiorobot.msgs.rosgraph_msgs import Clock as ClockMsg
+
+    context = Context()
+    rclpy.init(context=context)
+    node = rclpy.create_node("sim_rate", context=context, parameter_overrides=[Parameter("use_sim_time", value=True)])
+    clock_pub = node.create_publisher(ClockMsg, "/clock", 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+
+    def spin() -> None:
+        try:
+            executor.spin()
+        except ExternalShutdownException:
+            pass
+
+    spinner = threading.Thread(target=spin)
+    spinner.start()
+
+    def set_sim_time(sec: int) -> None:
+        clock_pub.publish(ClockMsg(clock=Time(seconds=sec).to_msg()))
+        _wait(lambda: node.get_clock().now().nanoseconds == sec * 10**9, f"sim time never read {sec} s")
+
+    woke_at: list[int] = []
+    try:
+        set_sim_time(100)
+        rate = node.create_rate(1e-4)  # a period of 10,000 s of sim time (the wall clock would never get there)
+        sleeper = threading.Thread(target=lambda: (rate.sleep(), woke_at.append(node.get_clock().now().nanoseconds)))
+        sleeper.start()
+        set_sim_time(5_000)
+        assert sleeper.is_alive() and not woke_at  # half a period of sim time later
+        set_sim_time(10_101)
+        sleeper.join(10)
+        assert not sleeper.is_alive() and woke_at and woke_at[0] >= 10_100 * 10**9
+    finally:
+        executor.shutdown()
+        spinner.join(10)
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
