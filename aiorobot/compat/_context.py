@@ -454,7 +454,10 @@ class Context:
             loop, runtime = self.loop, self.runtime
             if loop is not None and runtime is not None and not loop.is_closed():
                 loop.call_soon_threadsafe(runtime.shutdown)
-                spinning_here = loop.is_running() and self._spin_thread == threading.get_ident()
+                # a spin of this thread, its loop running or about to (run_until_complete between
+                # registering its done callback and running the loop) or just stopped: raised here,
+                # the KeyboardInterrupt would leave that callback to stop the loop's next run
+                spinning_here = self._spin_thread == threading.get_ident()
                 if (spinning_here or self._main_spin_depth > 0) and not self._interrupted:
                     # Raising here would leave the KeyboardInterrupt inside whichever task step runs
                     # ("Task exception was never retrieved"). Wake the spin instead: it raises

@@ -195,3 +195,42 @@ def test_a_ctrl_c_landing_in_a_weakref_callback_still_reaches_the_program(tmp_pa
     assert program.finish() == 0, program.output
     assert "interrupted, ok = False" in program.output, program.output
     assert "Exception ignored" not in program.output and "Traceback" not in program.output, program.output
+
+
+def test_a_ctrl_c_as_a_spin_starts_its_loop_is_raised_by_the_spin(tmp_path: Path):
+    # the SIGINT lands inside run_until_complete, after it hooked its done callback to the spin's
+    # task and before the loop runs: raised there, that callback later stopped the loop under the
+    # context's shutdown ("Event loop stopped before Future completed")
+    script = tmp_path / "interrupted_as_the_spin_starts.py"
+    script.write_text(textwrap.dedent("""
+        import asyncio, signal
+        import rclpy
+        from aiorobot.compat._context import default_context
+
+        rclpy.init()
+        node = rclpy.create_node('starting_spin')
+        loop = default_context().loop
+
+        class Task(asyncio.Task):
+            def add_done_callback(self, fn, **kw):
+                super().add_done_callback(fn, **kw)
+                if fn.__name__ == '_run_until_complete_cb':
+                    signal.raise_signal(signal.SIGINT)  # the handler runs as this call returns
+
+        def task_factory(loop, coro, **kw):
+            loop.set_task_factory(None)
+            return Task(coro, loop=loop, **kw)
+
+        loop.set_task_factory(task_factory)
+        try:
+            rclpy.spin_once(node, timeout_sec=30.0)
+            print('the Ctrl-C was lost', flush=True)
+        except KeyboardInterrupt:
+            print('interrupted, ok =', rclpy.ok(), flush=True)
+        rclpy.try_shutdown()
+        print('ended', flush=True)
+    """))
+    program = Program(str(script), exec_args=("--transport", "local"))
+    assert program.finish() == 0, program.output
+    assert "interrupted, ok = False" in program.output and "ended" in program.output, program.output
+    assert "Traceback" not in program.output, program.output
