@@ -397,6 +397,17 @@ class _Peer:
             self.proc.stdout.close()
 
 
+def open_router(port: int) -> Any:
+    """A zenoh router session on ``tcp/127.0.0.1:<port>`` for the pairs (multicast scouting off)."""
+    import zenoh
+
+    cfg = zenoh.Config()
+    cfg.insert_json5("mode", '"router"')
+    cfg.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
+    cfg.insert_json5("scouting/multicast/enabled", "false")
+    return zenoh.open(cfg)
+
+
 def _stats(values_ns: list[int]) -> dict[str, Any]:
     import numpy as np
 
@@ -408,19 +419,13 @@ def _stats(values_ns: list[int]) -> dict[str, Any]:
 
 def run(quick: bool = False) -> dict[str, Any]:
     """Each available path's small-message and image one-way latency and burst rate, interleaved."""
-    import zenoh
-
     from ._noise import NoiseMeter
 
     rounds, n_small, n_image, n_burst = (1, 200, 10, 2000) if quick else (3, 2000, 100, 20000)
     reasons = available_paths()
     paths = [p for p, why in reasons.items() if why is None]
     port = _free_port()
-    cfg = zenoh.Config()
-    cfg.insert_json5("mode", '"router"')
-    cfg.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
-    cfg.insert_json5("scouting/multicast/enabled", "false")
-    router = zenoh.open(cfg)
+    router = open_router(port)
     pairs: dict[str, tuple[_Peer, _Peer]] = {}
     pooled: dict[str, dict[str, Any]] = {
         p: {"small": [], "image": [], "burst": [], "small_sent": 0, "image_sent": 0, "small_cost": [], "image_cost": []}

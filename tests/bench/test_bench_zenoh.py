@@ -11,7 +11,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from aiorobot.bench._zenoh import _free_port, _Peer, _Record, _round, _warm_up, available_paths
+from aiorobot.bench._zenoh import _free_port, _Peer, _Record, _round, _warm_up, available_paths, open_router
 
 pytestmark = pytest.mark.timeout(90)
 _PATHS = [p for p, why in available_paths().items() if why is None and p != "dora-rs"]  # dora: test_bench_dora.py
@@ -19,14 +19,8 @@ _PATHS = [p for p, why in available_paths().items() if why is None and p != "dor
 
 @pytest.fixture
 def router_port() -> Iterator[int]:
-    import zenoh
-
     port = _free_port()
-    cfg = zenoh.Config()
-    cfg.insert_json5("mode", '"router"')
-    cfg.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
-    cfg.insert_json5("scouting/multicast/enabled", "false")
-    router = zenoh.open(cfg)
+    router = open_router(port)
     try:
         yield port
     finally:
