@@ -15,7 +15,8 @@ ROS 2 bridge. The server's capabilities, each in its own module:
 
 A topic published transient local (``/robot_description``, ``/map``, ``/tf_static``) keeps its
 last messages, and a client that subscribes later gets them, to it alone, as a late-joining ROS
-subscriber would.
+subscriber would; each of its messages reaches each client once, also when one is published as
+the client subscribes (such a topic is sent client by client, not broadcast).
 
 The control loop must never wait on a viewer: a topic costs its publisher one check while no
 client is subscribed, and otherwise one append to a bounded queue; a bridge thread serialises
@@ -25,6 +26,7 @@ queue drops its oldest entry when a slow client lets it fill.
 
 from __future__ import annotations
 
+import itertools
 import threading
 import time
 from collections import deque
@@ -51,6 +53,43 @@ _LARGE_TYPES = frozenset(
 _LATCHED_DEPTH = 16
 #: on sim time, the time is sent again after this long without a new /clock (10 Hz at least)
 _TIME_REPEAT_NS = 100_000_000
+
+
+class _Latched:
+    """A transient-local topic's kept messages, numbered, and the last one each subscribed client got.
+
+    Its messages go to each subscribed client by itself, never broadcast, and all sending happens
+    on the bridge's send thread: a client that subscribes while a message is on its way gets it
+    once, replayed or live, whichever comes first (broadcast, it got it live as well as replayed
+    when the server had counted the subscription before the message and told the bridge after)."""
+
+    def __init__(self, depth: int) -> None:
+        self.kept: deque[tuple[int, Any, int]] = deque(maxlen=depth)
+        self._seq = itertools.count()
+        self._got: dict[int, int] = {}  # client id -> the last number it got (send thread only)
+
+    def keep(self, msg: Any, t_ns: int) -> int:
+        """On a publishing thread: keep ``msg``; its number."""
+        seq = next(self._seq)
+        self.kept.append((seq, msg, t_ns))
+        return seq
+
+    def subscribe(self, client: int) -> list[tuple[int, Any, int]]:
+        """What ``client``, subscribing, has not got of the kept messages, in order."""
+        got = self._got.get(client, -1)
+        missing = [entry for entry in list(self.kept) if entry[0] > got]
+        self._got[client] = missing[-1][0] if missing else got
+        return missing
+
+    def live(self, seq: int) -> list[int]:
+        """The subscribed clients that have not got message ``seq`` yet (now counted as having it)."""
+        clients = [client for client, got in self._got.items() if got < seq]
+        for client in clients:
+            self._got[client] = seq
+        return clients
+
+    def unsubscribe(self, client: int) -> None:
+        self._got.pop(client, None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,10 +133,13 @@ class FoxgloveBridge(Node):
         self.player = player
         self._lock = threading.Lock()
         self._channels: dict[str, Any] = {}
-        self._latched: dict[str, deque[tuple[Any, int]]] = {}
+        self._latched: dict[str, _Latched] = {}
+        #: clients subscribing to and leaving transient-local topics, for the send thread
+        self._latched_events: deque[tuple[bool, int, str]] = deque()
         self._taps: list[Tap] = []
         self._client_pubs: dict[str, Any] = {}
-        self._pending: deque[tuple[Any, Any, int, int | None]] = deque(maxlen=self.queue_size)
+        #: (channel, message, time, to: None for all, a client id, or a _Latched topic's clients, its number)
+        self._pending: deque[tuple[Any, Any, int, Any, int]] = deque(maxlen=self.queue_size)
         self._wake = threading.Event()
         self._halt = threading.Event()
         self._thread: threading.Thread | None = None
@@ -226,15 +268,16 @@ class FoxgloveBridge(Node):
         return pub
 
     def replay_latched(self, client_id: int, topic: str) -> None:
-        """Send ``topic``'s kept transient-local messages to one client (it just subscribed)."""
-        with self._lock:
-            channel = self._channels.get(topic)
-            kept = list(self._latched.get(topic, ()))
-        if channel is None:
-            return
-        for msg, t_ns in kept:
-            self._pending.append((channel, msg, t_ns, client_id))
-        if kept:
+        """A client subscribed to ``topic``: if it is transient local, the send thread sends it the
+        kept messages it has not got, and from then on each new one."""
+        if topic in self._latched:
+            self._latched_events.append((True, client_id, topic))
+            self._wake.set()
+
+    def forget_latched(self, client_id: int, topic: str) -> None:
+        """A client unsubscribed from ``topic`` (or left): a new subscription gets the kept messages again."""
+        if topic in self._latched:
+            self._latched_events.append((False, client_id, topic))
             self._wake.set()
 
     # -- topics -------------------------------------------------------------------------
@@ -265,13 +308,12 @@ class FoxgloveBridge(Node):
             pending = self._pending
             wake = self._wake
             clock = self.runtime.clock
-            latched: deque[tuple[Any, int]] | None = None
+            latched: _Latched | None = None
             if endpoint.qos.durability == DurabilityPolicy.TRANSIENT_LOCAL:
-                latched = self._latched[name] = deque(maxlen=max(1, min(endpoint.qos.depth, _LATCHED_DEPTH)))
+                latched = self._latched[name] = _Latched(max(1, min(endpoint.qos.depth, _LATCHED_DEPTH)))
 
             def forward(msg: Any) -> None:
-                if latched is not None:
-                    latched.append((msg, clock.now().nanoseconds))
+                seq = latched.keep(msg, clock.now().nanoseconds) if latched is not None else 0
                 if not channel.has_sinks():
                     return  # nobody watches this topic: cost one check
                 now = clock.now().nanoseconds
@@ -282,7 +324,7 @@ class FoxgloveBridge(Node):
                     last[0] = now
                 if len(pending) == pending.maxlen:
                     self._dropped += 1
-                pending.append((channel, msg, now, None))
+                pending.append((channel, msg, now, latched, seq))
                 wake.set()
 
             qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, durability=endpoint.qos.durability, depth=max(1, endpoint.qos.depth))
@@ -304,25 +346,43 @@ class FoxgloveBridge(Node):
         self._taps.append(tap)
         add_tap(self.runtime, tap)
 
-    def _send_loop(self) -> None:
+    def _send(self, channel: Any, msg: Any, t_ns: int, client: int | None) -> None:
+        """On the send thread: log ``msg`` on ``channel``, to one client or (None) to every subscriber."""
         from aiorobot.msgs import serialize
 
+        try:
+            channel.log(serialize(msg), log_time=t_ns, sink_id=client)
+            self._sent += 1
+        except Exception as err:  # a closed channel during shutdown, a message that does not serialise
+            self.get_logger().warning(f"foxglove: cannot send on {channel.topic} ({err})", throttle_duration_sec=5.0)
+
+    def _send_loop(self) -> None:
         sent_clock: int | None = None
         sent_clock_at = 0
         period = 0.05 if (self._sim_time or self.playback is not None) else 0.5
         while not self._halt.is_set():
             self._wake.wait(period)
             self._wake.clear()
+            while self._latched_events:
+                subscribed, client, topic = self._latched_events.popleft()
+                latched, channel = self._latched.get(topic), self._channels.get(topic)
+                if latched is None or channel is None:
+                    continue
+                if not subscribed:
+                    latched.unsubscribe(client)
+                    continue
+                for _, msg, t_ns in latched.subscribe(client):
+                    self._send(channel, msg, t_ns, client)
             while self._pending:
                 try:
-                    channel, msg, t_ns, sink = self._pending.popleft()
+                    channel, msg, t_ns, to, seq = self._pending.popleft()
                 except IndexError:
                     break
-                try:
-                    channel.log(serialize(msg), log_time=t_ns, sink_id=sink)
-                    self._sent += 1
-                except Exception as err:  # a closed channel during shutdown, a message that does not serialise
-                    self.get_logger().warning(f"foxglove: cannot send on {channel.topic} ({err})", throttle_duration_sec=5.0)
+                if isinstance(to, _Latched):
+                    for client in to.live(seq):
+                        self._send(channel, msg, t_ns, client)
+                else:
+                    self._send(channel, msg, t_ns, to)
             server = self._server
             if server is None:
                 continue

@@ -22,6 +22,9 @@ def make_listener(bridge: FoxgloveBridge) -> Any:
         def on_subscribe(self, client: Any, channel: Any) -> None:
             bridge.replay_latched(int(client.id), str(channel.topic))
 
+        def on_unsubscribe(self, client: Any, channel: Any) -> None:
+            bridge.forget_latched(int(client.id), str(channel.topic))
+
         def on_client_advertise(self, client: Any, channel: Any) -> None:
             bridge.client_publishing.on_advertise(client, channel)
 

@@ -3,6 +3,7 @@ refused) and the replay of transient-local topics (robot_description) to late cl
 
 from __future__ import annotations
 
+import asyncio
 import struct
 from pathlib import Path
 
@@ -117,3 +118,38 @@ async def test_robot_description_is_replayed_to_a_late_client_only() -> None:
                 await late.until(lambda: len(texts(late)) >= 2)
             assert texts(early) == ["<robot name='v1'/>", "<robot name='v2'/>"]  # no second copy of v1
             assert texts(late) == ["<robot name='v1'/>", "<robot name='v2'/>"]
+async def test_a_subscription_the_bridge_hears_of_after_a_message_gets_that_message_once() -> None:
+    # The server counts a subscription, then tells the bridge (its listener's on_subscribe). A
+    # transient-local message published in between reached the client live and was then replayed to
+    # it: twice. Here the notification is held back until the message has gone past.
+    async with Runtime(handle_signals=False) as rt:
+        rsp = rt.add_node(Node("robot_state_publisher"))
+        pub = rsp.create_publisher(String, "/robot_description", QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+        probe = rsp.create_publisher(String, "/probe", 10)
+        bridge = rt.add_node(FoxgloveBridge(port=0))
+        held: list[tuple[int, str]] = []
+        tell = bridge.replay_latched
+        bridge.replay_latched = lambda client_id, topic: held.append((client_id, topic))  # type: ignore[method-assign]
+
+        def texts(client: FoxgloveClient, channel_id: int) -> list[str]:
+            return [deserialize(f[13:], String).data for f in client.frames(MESSAGE_DATA)
+                    if struct.unpack_from("<I", f, 1)[0] == channel_id]
+
+        async with FoxgloveClient(bridge.bound_port) as client:
+            description, probe_channel = await client.channel("/robot_description"), await client.channel("/probe")
+            await client.send({"op": "subscribe", "subscriptions": [
+                {"id": description["id"], "channelId": description["id"]}, {"id": probe_channel["id"], "channelId": probe_channel["id"]}]})
+            async with asyncio.timeout(20):  # the server has both subscriptions (told from its thread)
+                while len(held) < 2:
+                    await asyncio.sleep(0.005)
+            pub.publish(String(data="<robot name='v1'/>"))
+            probe.publish(String(data="after v1"))  # sent by the same thread after v1: v1 has gone past
+            await client.until(lambda: texts(client, probe_channel["id"]))
+            for client_id, topic in held:
+                tell(client_id, topic)
+            await client.until(lambda: texts(client, description["id"]))
+            pub.publish(String(data="<robot name='v2'/>"))
+            await client.until(lambda: len(texts(client, description["id"])) >= 2)
+            assert texts(client, description["id"]) == ["<robot name='v1'/>", "<robot name='v2'/>"]
+
+
