@@ -240,6 +240,7 @@ class Context:
 
     def require_ok(self, what: str) -> None:
         if not self._ok or self.loop is None:
+            self.raise_if_interrupted()  # shut down by a Ctrl-C that came just now: that is what it is
             from .rclpy.exceptions import NotInitializedException
 
             raise NotInitializedException(f"{what}: rclpy.init() has not been called (or rclpy.shutdown() was)")

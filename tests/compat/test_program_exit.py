@@ -234,3 +234,39 @@ def test_a_ctrl_c_as_a_spin_starts_its_loop_is_raised_by_the_spin(tmp_path: Path
     assert program.finish() == 0, program.output
     assert "interrupted, ok = False" in program.output and "ended" in program.output, program.output
     assert "Traceback" not in program.output, program.output
+
+
+def test_a_ctrl_c_between_two_passes_of_spin_is_a_keyboard_interrupt(tmp_path: Path):
+    # rclpy.spin's loop: the SIGINT lands in spin_once after its check for an earlier Ctrl-C and
+    # before its check that the context is up; the handler has shut the context down, and that
+    # check raised NotInitializedException ("rclpy.init() has not been called") out of spin
+    script = tmp_path / "interrupted_between_passes.py"
+    script.write_text(textwrap.dedent("""
+        import signal
+        import rclpy
+        from aiorobot.compat._context import default_context
+
+        rclpy.init()
+        node = rclpy.create_node('spinning')
+        ctx = default_context()
+        checked = ctx.raise_if_interrupted
+
+        def then_interrupted():
+            checked()
+            if ctx.raise_if_interrupted is then_interrupted:
+                ctx.raise_if_interrupted = checked
+                signal.raise_signal(signal.SIGINT)  # the handler runs as this call returns
+
+        ctx.raise_if_interrupted = then_interrupted
+        try:
+            rclpy.spin(node)
+            print('spin returned', flush=True)
+        except KeyboardInterrupt:
+            print('interrupted, ok =', rclpy.ok(), flush=True)
+        rclpy.try_shutdown()
+        print('ended', flush=True)
+    """))
+    program = Program(str(script), exec_args=("--transport", "local"))
+    assert program.finish() == 0, program.output
+    assert "interrupted, ok = False" in program.output and "ended" in program.output, program.output
+    assert "Traceback" not in program.output, program.output
