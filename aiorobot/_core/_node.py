@@ -762,6 +762,46 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             return None
 
 
+    def _invoke_now(self, entity: Any, lock: Any, fn: Callable[..., Any], arg: Any, done: Callable[[Any], Any]) -> None:
+        """:meth:`_invoke` without a coroutine, for a plain-function callback run at once
+        (``deliver_eagerly``): ``lock``, the group's, is held already (None: a lockless group) and
+        released here, then ``done(None)`` is called. A callback that returns an awaitable after
+        all is awaited in a task, which releases and calls ``done`` when it ends."""
+        start = time.monotonic_ns()
+        try:
+            result = fn(arg)
+        except BaseException as err:
+            self._record_callback(entity, start)
+            if lock is not None:
+                lock.release()
+            done(None)
+            if not isinstance(err, Exception):
+                raise
+            self._report_failure(f"callback of {_describe(entity)}", err)  # logged, as _invoke does
+            return
+        if result is not None and inspect.isawaitable(result):
+            self._create_task(self._finish_now(entity, lock, result, start, done), name=f"callback of {_describe(entity)}")
+            return
+        self._record_callback(entity, start)
+        if lock is not None:
+            lock.release()
+        done(None)
+
+    async def _finish_now(self, entity: Any, lock: Any, result: Awaitable[Any], start: int, done: Callable[[Any], Any]) -> None:
+        """The rest of a callback :meth:`_invoke_now` started that returned an awaitable."""
+        try:
+            await result
+        except asyncio.CancelledError:
+            raise
+        except Exception as err:  # noqa: BLE001
+            self._report_failure(f"callback of {_describe(entity)}", err)
+        finally:
+            self._record_callback(entity, start)
+            if lock is not None:
+                lock.release()
+            done(None)
+
+
 #: What :meth:`Node._invoke` runs a callback of a lockless group's own class under, inside its ``async with``.
 _UNLOCKED = ReentrantCallbackGroup()
 

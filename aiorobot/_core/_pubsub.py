@@ -60,6 +60,34 @@ M = TypeVar("M")
 _BATCH = 64
 
 
+class _EagerDelivery(threading.local):
+    """While a transport delivers a received message (:func:`deliver_eagerly`), the idle
+    subscriptions it wakes collect in ``ready`` instead of waking their dispatchers."""
+
+    ready: list[Subscription[Any]] | None = None
+
+
+_EAGER = _EagerDelivery()
+
+
+def deliver_eagerly(publish: Callable[..., Any], *args: Any) -> None:
+    """``publish(*args)`` (a transport handing a received message to the bus, on the loop of the
+    subscriptions it is for), then run at once, in this call, the plain-function callbacks of the
+    subscriptions it woke that were idle: their dispatchers would run them one loop iteration
+    later, so a received message reaches its callback without that iteration. A subscription
+    whose callback is a coroutine function, whose group is busy, or that takes MessageInfo (or
+    was made with ``raw``, or runs under ``debug_messages``) is woken as with any publish; so is
+    one that a callback run here publishes to (only the received message is delivered eagerly)."""
+    ready: list[Subscription[Any]] = []
+    _EAGER.ready = ready
+    try:
+        publish(*args)
+    finally:
+        _EAGER.ready = None
+    for sub in ready:
+        sub._run_now()
+
+
 def _type_name(msg_type: Any) -> str:
     return str(getattr(msg_type, "__msgtype__", None) or getattr(msg_type, "__name__", repr(msg_type)))
 
@@ -425,6 +453,8 @@ class Subscription(Endpoint, Generic[M]):
         self._task: asyncio.Task[None] | None = None
         self._busy = 0
         self._debug = False  # Runtime(debug_messages=True): check callbacks leave messages as they found them
+        #: :func:`deliver_eagerly` may run the callback (set when the dispatcher starts)
+        self._eager = False
         self.received = 0
         self.dropped = 0
         if event_callbacks is not None and not isinstance(event_callbacks, SubscriptionEventCallbacks):
@@ -466,9 +496,29 @@ class Subscription(Endpoint, Generic[M]):
         self.received += 1
         waiter = self._waiter
         if waiter is not None:
+            if self._eager:
+                ready = _EAGER.ready
+                if ready is not None:
+                    ready.append(self)  # deliver_eagerly runs the callback, or wakes the dispatcher
+                    return
             self._waiter = None
             if not waiter.done():
                 waiter.set_result(None)
+
+    def _run_now(self) -> None:
+        """For :func:`deliver_eagerly`: run the callback on the queued message here, as the idle
+        dispatcher would, when the callback group is free; else wake the dispatcher."""
+        waiter = self._waiter
+        if waiter is None or waiter.done() or not self._queue or self.destroyed:
+            return  # the dispatcher is running (or gone): it takes the message
+        if self._infos is None:
+            lock = self.callback_group._group_lock
+            if lock is None or lock.try_acquire():
+                self._busy += 1
+                self.node._invoke_now(self, lock, self.callback, self._queue.popleft(), self._callback_done)
+                return
+        self._waiter = None
+        waiter.set_result(None)
 
     def _use_infos(self) -> None:
         """Switch to info mode (on the node's loop thread): existing messages get no publisher data."""
@@ -546,6 +596,12 @@ class Subscription(Endpoint, Generic[M]):
         if self._deadline is not None:
             self._deadline.start()
         if self.callback is not None and self._task is None:
+            group = self.callback_group
+            self._eager = (
+                not (self._debug or self.raw or self._wants_info)
+                and (group._group_lock is not None or not group.exclusive)
+                and not _is_async(self.callback)
+            )
             self._task = self.node._create_task(
                 self._dispatch(), name=f"dispatch {self.topic_name} -> {self.node_name}"
             )
@@ -648,6 +704,11 @@ def _takes_message_info(callback: Callable[..., Any]) -> bool:
         "Subscription.__init__(): callback should be either be callable with one argument"
         "(to get only the message) or two (to get message and message info)"
     )
+
+
+def _is_async(callback: Callable[..., Any]) -> bool:
+    """Whether ``callback`` is a coroutine function (or an object whose ``__call__`` is one)."""
+    return inspect.iscoroutinefunction(callback) or inspect.iscoroutinefunction(getattr(callback, "__call__", None))
 
 
 def _with_info(callback: Callable[..., Any]) -> Callable[[tuple[Any, Any]], Any]:

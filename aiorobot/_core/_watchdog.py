@@ -60,12 +60,12 @@ def blocked_at(frame: FrameType | None) -> tuple[str, str, str]:
     f = frame
     while f is not None:
         code = f.f_code
-        if code.co_name in ("_invoke", "_run_hook") and code.co_filename.endswith("_node.py"):
+        if code.co_name in ("_invoke", "_invoke_now", "_run_hook") and code.co_filename.endswith("_node.py"):
             try:
                 local = f.f_locals
                 owner = local.get("self")
                 node = owner.get_fully_qualified_name() if owner is not None else ""
-                if code.co_name == "_invoke":
+                if code.co_name in ("_invoke", "_invoke_now"):
                     from ._node import _describe
 
                     entity = _describe(local.get("entity"))

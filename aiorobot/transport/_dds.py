@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from .._core._errors import ConfigError, ServiceError
-from .._core._pubsub import Publisher, Subscription, Tap
+from .._core._pubsub import Publisher, Subscription, Tap, deliver_eagerly
 from .._core._qos import QoSProfile, ReliabilityPolicy
 from .._core._services import Client, Service, _Call, _reply
 from .._core._transport import Transport
@@ -277,7 +277,7 @@ class _Inbound:
                 continue
             transport._received += 1
             if loop is not None:
-                post(loop, transport._inject, self, handle, msg)
+                post(loop, deliver_eagerly, transport._inject, self, handle, msg)  # (callbacks run at once)
 
 
 class _ServiceSide:

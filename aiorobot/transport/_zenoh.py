@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from .._core._handoff import post
-from .._core._pubsub import Publisher, Subscription, Tap
+from .._core._pubsub import Publisher, Subscription, Tap, deliver_eagerly
 from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
@@ -468,10 +468,14 @@ class _Inbound:
                 self._gid, self._injector = gid, injector
         if injector.destroyed:
             return
+        local = self.transport._local
+        local.injecting = True  # outbound taps must not echo it back
         try:
             injector.publish(msg)
         except Exception as err:  # noqa: BLE001
             self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
+        finally:
+            local.injecting = False
 
     def close(self) -> None:
         if self.zsub is not None:
@@ -535,11 +539,11 @@ class _Inbox:
         """On the inbox's loop: inject queued messages in arrival order, at most ``chunk`` of one
         topic (its smallest subscription depth) before the dispatchers run; then the next drain.
         One drain is due at a time; messages that pile up while the process is descheduled so never
-        fill a subscription queue past its depth, and topics keep their relative order."""
+        fill a subscription queue past its depth, and topics keep their relative order. Each
+        message is delivered eagerly (``deliver_eagerly``): an idle subscription's plain-function
+        callback runs here, not one loop iteration later in its dispatcher."""
         pending = self.pending
-        local = self.transport._local
         taken: dict[int, int] = {}
-        local.injecting = True
         try:
             for _ in range(MAX_DRAIN):
                 try:
@@ -553,10 +557,13 @@ class _Inbox:
                 taken[id(inbound)] = n + 1
                 if inbound.zsub is None:
                     continue  # the topic's last subscription left meanwhile
-                inbound._inject(*decoded)
-        finally:
-            local.injecting = False
-        loop = self.loop
+                deliver_eagerly(inbound._inject, *decoded)
+        finally:  # (also when a callback run here raises KeyboardInterrupt: the rest is not stranded)
+            self._next()
+
+    def _next(self) -> None:
+        """After a drain: the next one, when messages are left or came in meanwhile."""
+        pending, loop = self.pending, self.loop
         if not pending or loop is None or loop.is_closed():
             with self._arming:
                 self.armed = False

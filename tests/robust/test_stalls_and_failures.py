@@ -49,6 +49,33 @@ async def test_a_stall_is_reported_once_with_node_entity_and_stack_and_counted(e
     assert "in tick" in reports[0] and "time.sleep(self.hold_sec)" in reports[0]
 
 
+async def test_a_stall_in_a_callback_run_on_delivery_names_its_subscription(caplog):
+    # a transport runs an idle subscription's plain callback inside its delivery (deliver_eagerly),
+    # outside the dispatcher task: the report still names the node and the subscription
+    from aiorobot._core._pubsub import deliver_eagerly
+    from aiorobot.msgs.std_msgs import Int32
+
+    caplog.set_level(logging.WARNING, logger="aiorobot.runtime")
+    async with Runtime(stall_threshold=0.05) as rt:
+        node = rt.add_node(Node("reader"))
+        pub = node.create_publisher(Int32, "/frames", 10)
+        got: list[int] = []
+
+        def read(msg: Int32) -> None:
+            got.append(msg.data)
+            time.sleep(0.5)  # the blocking call under test
+
+        node.create_subscription(Int32, "/frames", read, 10)
+        await rt.settle()
+        asyncio.get_running_loop().call_soon(deliver_eagerly, pub.publish, Int32(data=1))
+        await wait_until(lambda: rt.statistics()["stalls"] != {})
+        stats = rt.statistics()
+    assert got == [1]
+    assert stats["stalls"] == {("main", "/reader", "subscription /frames"): 1}
+    reports = [r.getMessage() for r in caplog.records if "stalled" in r.getMessage()]
+    assert len(reports) == 1 and "main loop stalled: subscription /frames in /reader" in reports[0]
+
+
 async def test_no_stall_is_reported_while_callbacks_are_short(caplog):
     async with Runtime(stall_threshold=0.5) as rt:
         node = rt.add_node(Blocker(hold_sec=0.0))

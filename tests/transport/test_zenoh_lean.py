@@ -227,3 +227,29 @@ async def test_a_loop_stalled_past_the_backlog_limit_loses_the_oldest_and_says_s
         assert stream == sorted(stream) and len(stream) <= 300 - backlog  # the oldest went, in order
         assert any("50 were waiting for the main loop" in r.getMessage() for r in caplog.records)
         child.send("bye")
+
+
+async def test_a_callback_run_on_arrival_publishes_to_other_processes(router_port: int) -> None:
+    """A received message's plain callback runs as the message is delivered (eagerly, not in its
+    dispatcher); what it publishes still goes out over zenoh: the transport's guard against echoing
+    received messages back does not cover it."""
+    async with _beside(DRIVER, router_port, "relay") as (child, rt, node):
+        echo = node.create_publisher(Twist, "/cmd_echo", QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+        relayed: list[int] = []
+
+        def relay(msg: Twist) -> None:
+            relayed.append(int(msg.linear.x))
+            echo.publish(msg)
+
+        node.create_subscription(Twist, "/cmd_vel", relay, 10)
+        transport = ZenohTransport(connect=[f"tcp/127.0.0.1:{router_port}"])
+        async with Runtime(transport=transport, handle_signals=False) as far:
+            heard: list[int] = []
+            far.add_node(Node("listener")).create_subscription(Twist, "/cmd_echo", lambda m: heard.append(int(m.linear.x)), 50)
+            await wait_until(lambda: len(rt.graph.subscriptions_of("/cmd_echo")) == 1)
+            await _first_arrival(child, rt, "/cmd_vel", relayed)
+            child.send("steady 20")
+            await child.expect("done")
+            await wait_until(lambda: [x for x in heard if x >= 0] == list(range(20)))
+        assert [x for x in relayed if x >= 0] == list(range(20))
+        child.send("bye")
