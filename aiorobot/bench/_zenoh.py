@@ -211,6 +211,10 @@ async def _iceoryx2_receiver(port: int) -> None:
 
     import iceoryx2 as iox2
 
+    from ..transport._iceoryx2 import quiet
+
+    quiet()
+
     rec = _Record()
     node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
     subs = []
@@ -248,6 +252,10 @@ async def _iceoryx2_sender(port: int) -> None:
 
     import iceoryx2 as iox2
     import numpy as np
+
+    from ..transport._iceoryx2 import quiet
+
+    quiet()
 
     node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
     pubs = {}

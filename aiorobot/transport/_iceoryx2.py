@@ -36,7 +36,7 @@ from ..msgs import deserialize as _deserialize
 from ..msgs._cdr_gen import build_parts_serializer
 from ._zenoh import _ANY_QOS, ZenohTransport, _Inbound
 
-__all__ = ["BORROW_MAX", "BUFFER_SIZE", "INITIAL_BYTES", "Iceoryx2Receiver", "Iceoryx2Sender", "unavailable"]
+__all__ = ["BORROW_MAX", "BUFFER_SIZE", "INITIAL_BYTES", "Iceoryx2Receiver", "Iceoryx2Sender", "quiet", "unavailable"]
 
 GID_BYTES = 16
 #: samples a subscriber holds queued (its buffer) and holds for messages still alive (borrowed)
@@ -57,10 +57,20 @@ def unavailable() -> str | None:
     return None if importlib.util.find_spec("iceoryx2") else "iceoryx2 is not installed (pip install iceoryx2)"
 
 
+def quiet() -> None:
+    """iceoryx2's own log at errors only, unless ``IOX2_LOG_LEVEL`` says otherwise: at its default
+    level every process that opens a node prints "No config file was loaded, a config with default
+    values will be used." on stderr (what goes wrong here reaches us as an exception, and is said)."""
+    import iceoryx2 as iox2
+
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+
+
 def _open(service: str) -> tuple[Any, Any, Any]:
     """This process's iceoryx2 node, and the topic's publish-subscribe and event services."""
     import iceoryx2 as iox2
 
+    quiet()
     node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
     # what processes that died (SIGKILL) left behind: their ports count against a service's
     # publishers and subscribers until some process releases them
@@ -97,6 +107,8 @@ class Iceoryx2Sender:
             .create()
         )
         self._notifier = event.notifier_builder().create()
+        self._service = data
+        self.skipped = 0  # messages not serialised: no iceoryx2 subscriber was connected
         serialize = _SERIALIZERS.get(msg_type)
         if serialize is None:
             serialize = _SERIALIZERS[msg_type] = build_parts_serializer(msg_type)
@@ -112,6 +124,9 @@ class Iceoryx2Sender:
         transport = self.transport
         if transport._local.injecting:
             return  # it came from another process: do not echo it back
+        if not self._service.dynamic_config.number_of_subscribers:
+            self.skipped += 1  # nobody to send it to (0.1 us to ask; serialising an image: ~100 us)
+            return
         try:
             parts, size = self._serialize(msg)
         except (TypeError, ValueError) as err:

@@ -135,6 +135,9 @@ async def test_images_from_another_process_arrive_intact_in_order_as_views_of_th
             _check(frames, 0)
         finally:
             await child.stop()
+        assert child.proc.stderr is not None
+        err = (await child.proc.stderr.read()).decode()
+        assert "No config file was loaded" not in err, err  # iceoryx2's start-up notice, said by every process
 
 
 async def test_a_publisher_killed_with_sigkill_leaves_the_receiver_running_and_a_new_one_delivers(router_port: int) -> None:
@@ -225,3 +228,36 @@ async def test_iceoryx2_topics_without_iceoryx2_is_one_config_error_before_anyth
     with pytest.raises(ConfigError, match=r"/cam over iceoryx2: expected the iceoryx2 package, found none \(iceoryx2 is not"):
         async with Runtime(transport=ZenohTransport(iceoryx2_topics=["cam"]), handle_signals=False):
             pass
+
+
+async def test_a_sender_with_no_iceoryx2_subscriber_serialises_nothing_until_one_connects(router_port: int) -> None:
+    import ctypes
+
+    import iceoryx2 as iox2
+
+    from aiorobot.transport._iceoryx2 import Iceoryx2Sender
+
+    service = f"aiorobot/test/{router_port}/idle"
+    async with Runtime(transport=ZenohTransport(connect=[f"tcp/127.0.0.1:{router_port}"]), handle_signals=False) as rt:
+        sender = Iceoryx2Sender(rt.transport, Image, "/image", service, max_bytes=320 * 240 * 3 + 1024)
+        pub = rt.add_node(Node("camera")).create_publisher(Image, "/image", 5)
+        frame = lambda i: Image(height=240, width=320, encoding="rgb8", step=960, data=_pixels(i))  # noqa: E731
+        for i in range(3):
+            pub.publish(frame(i))
+        assert (sender.sent, sender.skipped) == (0, 3)
+        node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
+        data = (
+            node.service_builder(iox2.ServiceName.new(service))
+            .publish_subscribe(iox2.Slice[ctypes.c_uint8])
+            .subscriber_max_buffer_size(8)
+            .subscriber_max_borrowed_samples(8)
+            .open_or_create()
+        )
+        subscriber = data.subscriber_builder().buffer_size(8).create()
+        pub.publish(frame(3))
+        assert (sender.sent, sender.skipped) == (1, 3)
+        sample = subscriber.receive()
+        assert sample is not None and sample.header.number_of_elements > 320 * 240 * 3
+        del sample
+        subscriber.delete()
+        sender.close()
