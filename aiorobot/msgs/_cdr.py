@@ -159,6 +159,31 @@ def deserialize(data: bytes | bytearray | memoryview, msg_type: type | str, *, v
     return obj
 
 
+def decoder(msg_type: type, *, view: bool = False) -> Callable[[Any], Any]:
+    """``deserialize(data, msg_type, view=view)`` as one function for a receiver that decodes many
+    messages of one type: little-endian CDR (what every ROS 2 node sends) goes straight to the
+    type's generated decoder; anything else (big endian, a bad header, malformed or trailing
+    bytes) goes through :func:`deserialize`, which decodes it or raises its DeserializationError."""
+    fn = _DES.get((msg_type, "<", view))
+    if fn is None:
+        from ._cdr_gen import build_deserializer
+
+        fn = _DES[(msg_type, "<", view)] = build_deserializer(msg_type, "<", view)
+
+    def decode(data: Any) -> Any:
+        if data[:2] == b"\0\1":
+            try:
+                obj, end = fn(data, 4)
+            except _DES_ERRORS:
+                pass  # deserialize says what is wrong
+            else:
+                if len(data) - end <= 3:
+                    return obj
+        return deserialize(data, msg_type, view=view)
+
+    return decode
+
+
 def _des_error(cls: type, data: Any, exc: BaseException) -> DeserializationError:
     from ._cdr_gen import fmt_path, where
 

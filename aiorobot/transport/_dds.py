@@ -52,6 +52,7 @@ from ._dds_wire import (
     user_data,
 )
 from .._core._handoff import post
+from ..msgs._cdr import decoder
 from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer, _ThreadFlags, delivery_loop
 
 if TYPE_CHECKING:
@@ -242,6 +243,7 @@ class _Inbound:
         self.qos: QoSProfile | None = None
         self.reader: Any = None
         self.fallback = _Injector(transport._owner, msg_type, topic, _FALLBACK_QOS, "<dds>", hidden=True)
+        self.decode = decoder(msg_type)
 
     def declare(self, qos: QoSProfile) -> None:
         merged = _merged(self.qos, qos, reader=True)
@@ -260,8 +262,7 @@ class _Inbound:
         """On a Cyclone thread: take, check and decode, then hand over to the loop the topic's
         subscriptions run on (the priority loop's when one runs there, else the main loop)."""
         transport = self.transport
-        from ..msgs import deserialize
-
+        decode = self.decode
         loop = delivery_loop(self.subscriptions, transport._loop)  # the priority loop's, if one subscribes
         for data, info in transport._take(reader):
             if not info.valid_data:
@@ -271,7 +272,7 @@ class _Inbound:
                 transport._warn("type_hash", f"dropped a sample on {self.topic} from a writer whose type hash differs")
                 continue
             try:
-                msg = deserialize(data, self.msg_type)
+                msg = decode(data)
             except Exception as err:  # noqa: BLE001 - nothing from the network may escape
                 transport._drop_sample(f"rt{self.topic}", err)
                 continue

@@ -32,7 +32,6 @@ from typing import Any
 
 from .._core._pubsub import Tap
 from ..msgs import DeserializationError as _DeserializationError
-from ..msgs import deserialize as _deserialize
 from ..msgs._cdr_gen import build_parts_serializer
 from ._zenoh import _ANY_QOS, ZenohTransport, _Inbound
 
@@ -236,7 +235,7 @@ class Iceoryx2Receiver(_Inbound):
             else:
                 data = bytes(memoryview(buf).cast("B")[GID_BYTES:])
                 self.copied += 1
-            msg = _deserialize(data, self.msg_type, view=True)
+            msg = self.decode(data)
         except Exception as err:  # noqa: BLE001 - nothing from another process may escape
             transport._drop_sample(f"{self.topic} (iceoryx2)", err)
             return None

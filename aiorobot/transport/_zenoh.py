@@ -42,7 +42,7 @@ from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
 from .._core._transport import Transport
 from ..msgs import DeserializationError as _DeserializationError
-from ..msgs import deserialize as _deserialize
+from ..msgs._cdr import decoder
 from ..msgs import serialize as _serialize
 from ._diagnose import NOTHING_LISTENS, host_port, why_unreachable
 from ._session_config import (
@@ -57,6 +57,7 @@ from ._session_config import (
     zenoh_error_text,
 )
 from ._wire import (
+    ATTACHMENT_SIZE,
     WireError,
     attachment_gid,
     attachment_head,
@@ -386,6 +387,7 @@ class _Inbound:
         self._injector: _Injector | None = None  # the injector of the last sample's GID
         self._gid = b""
         self.inbox: _Inbox | None = None  # the loop's that delivers it; None: the main loop's
+        self.decode = decoder(msg_type, view=True)  # received messages: arrays are read-only views
 
     def add(self, sub: Any) -> None:
         self.subscriptions.append(sub)
@@ -445,10 +447,13 @@ class _Inbound:
                     f"found {found_hash or 'none'}; the two sides use different definitions"
                 )
             raw = sample.attachment
-            gid = attachment_gid(None if raw is None else raw.to_bytes())
+            att = None if raw is None else raw.to_bytes()
+            if att is None or len(att) != ATTACHMENT_SIZE or att[16] != 16:
+                attachment_gid(att)  # raises the WireError that says what is wrong
+            gid = att[17:]
             payload = sample.payload
             data = payload.to_bytes()
-            msg = _deserialize(data, self.msg_type, view=True)  # arrays: read-only views into the bytes
+            msg = self.decode(data)  # arrays: read-only views into the bytes
             if len(data) >= SHM_MIN_CHECK and payload.as_shm() is not None:
                 transport._received_shm += 1
         except Exception as err:  # noqa: BLE001 - nothing from the network may escape

@@ -257,3 +257,27 @@ def test_services_and_actions_parts_round_trip() -> None:
     fb.goal_id.uuid[:] = np.arange(16)
     back = msgs.deserialize(msgs.serialize(fb), "example_interfaces/action/Fibonacci_FeedbackMessage")
     assert back == fb
+
+
+@pytest.mark.parametrize("name", ["sensor_msgs/msg/Image", "nav_msgs/msg/Odometry", "geometry_msgs/msg/Twist",
+                                  "tf2_msgs/msg/TFMessage", "sensor_msgs/msg/JointState"])
+def test_a_receiver_s_decoder_decodes_and_refuses_as_deserialize_does(name: str) -> None:
+    from aiorobot.msgs._cdr import decoder
+
+    cls = msgs.get(name)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    msg = random_message(cls, rng)
+    little = msgs.serialize(msg)
+    big = bytes(rosbags_store().serialize_cdr(to_rosbags(msg), name, little_endian=False))
+    for view in (False, True):
+        decode = decoder(cls, view=view)
+        for data in (little, memoryview(little), little + b"\0\0\0", big):
+            assert decode(data) == msg == msgs.deserialize(data, cls, view=view)
+        for bad in (little[:-5], little + b"\0" * 4, b"\1\1" + little[2:], little[:3]):
+            with pytest.raises(msgs.DeserializationError) as expected:
+                msgs.deserialize(bad, cls, view=view)
+            with pytest.raises(msgs.DeserializationError) as got:
+                decode(bad)
+            assert str(got.value) == str(expected.value)
+        if cls is Image:  # the view form: pixels are read-only views into the received bytes
+            assert decode(little).data.flags.writeable is not view
