@@ -82,8 +82,12 @@ def deliver_eagerly(publish: Callable[..., Any], *args: Any) -> None:
     _EAGER.ready = ready
     try:
         publish(*args)
-    finally:
+    except BaseException:
         _EAGER.ready = None
+        for sub in ready:
+            sub._run_now(run=False)  # their dispatchers take what was queued
+        raise
+    _EAGER.ready = None
     for sub in ready:
         sub._run_now()
 
@@ -505,13 +509,13 @@ class Subscription(Endpoint, Generic[M]):
             if not waiter.done():
                 waiter.set_result(None)
 
-    def _run_now(self) -> None:
+    def _run_now(self, *, run: bool = True) -> None:
         """For :func:`deliver_eagerly`: run the callback on the queued message here, as the idle
-        dispatcher would, when the callback group is free; else wake the dispatcher."""
+        dispatcher would, when the callback group is free (and ``run``); else wake the dispatcher."""
         waiter = self._waiter
         if waiter is None or waiter.done() or not self._queue or self.destroyed:
             return  # the dispatcher is running (or gone): it takes the message
-        if self._infos is None:
+        if run and self._infos is None:
             lock = self.callback_group._group_lock
             if lock is None or lock.try_acquire():
                 self._busy += 1

@@ -139,3 +139,23 @@ async def test_a_reentrant_group_callback_runs_eagerly_too(runtime) -> None:
     await _started(runtime, node)
     deliver_eagerly(pub.publish, Int32(data=7))
     assert got == [7]
+
+
+async def test_a_delivery_that_raises_leaves_what_it_queued_to_the_dispatchers(runtime) -> None:
+    node = runtime.add_node(Node("n"))
+    pub = node.create_publisher(Int32, "/x", 10)
+    got: list[int] = []
+    node.create_subscription(Int32, "/x", lambda m: got.append(m.data), 10)
+    await _started(runtime, node)
+
+    def publish_then_interrupted(msg: Int32) -> None:
+        pub.publish(msg)
+        raise KeyboardInterrupt  # (a Ctrl-C landing in the delivery)
+
+    try:
+        deliver_eagerly(publish_then_interrupted, Int32(data=4))
+    except KeyboardInterrupt:
+        pass
+    assert got == []  # not run in the interrupted delivery, but not stranded either
+    await settle(runtime)
+    assert got == [4]
