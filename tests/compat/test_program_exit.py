@@ -197,12 +197,29 @@ def test_a_ctrl_c_landing_in_a_weakref_callback_still_reaches_the_program(tmp_pa
     assert "Exception ignored" not in program.output and "Traceback" not in program.output, program.output
 
 
+def _spin_interrupted(script: Path, setup: str, spin: str) -> None:
+    """Run ``setup`` (rclpy initialised, a SIGINT arranged), then ``spin``, under ``aiorobot exec``:
+    the Ctrl-C must come out of ``spin`` as a KeyboardInterrupt, with the context shut down."""
+    script.write_text(textwrap.dedent(setup) + textwrap.dedent(f"""
+        try:
+            {spin}
+            print('the Ctrl-C was lost', flush=True)
+        except KeyboardInterrupt:
+            print('interrupted, ok =', rclpy.ok(), flush=True)
+        rclpy.try_shutdown()
+        print('ended', flush=True)
+    """))
+    program = Program(str(script), exec_args=("--transport", "local"))
+    assert program.finish() == 0, program.output
+    assert "interrupted, ok = False" in program.output and "ended" in program.output, program.output
+    assert "Traceback" not in program.output, program.output
+
+
 def test_a_ctrl_c_as_a_spin_starts_its_loop_is_raised_by_the_spin(tmp_path: Path):
     # the SIGINT lands inside run_until_complete, after it hooked its done callback to the spin's
     # task and before the loop runs: raised there, that callback later stopped the loop under the
     # context's shutdown ("Event loop stopped before Future completed")
-    script = tmp_path / "interrupted_as_the_spin_starts.py"
-    script.write_text(textwrap.dedent("""
+    _spin_interrupted(tmp_path / "interrupted_as_the_spin_starts.py", """
         import asyncio, signal
         import rclpy
         from aiorobot.compat._context import default_context
@@ -222,26 +239,14 @@ def test_a_ctrl_c_as_a_spin_starts_its_loop_is_raised_by_the_spin(tmp_path: Path
             return Task(coro, loop=loop, **kw)
 
         loop.set_task_factory(task_factory)
-        try:
-            rclpy.spin_once(node, timeout_sec=30.0)
-            print('the Ctrl-C was lost', flush=True)
-        except KeyboardInterrupt:
-            print('interrupted, ok =', rclpy.ok(), flush=True)
-        rclpy.try_shutdown()
-        print('ended', flush=True)
-    """))
-    program = Program(str(script), exec_args=("--transport", "local"))
-    assert program.finish() == 0, program.output
-    assert "interrupted, ok = False" in program.output and "ended" in program.output, program.output
-    assert "Traceback" not in program.output, program.output
+    """, "rclpy.spin_once(node, timeout_sec=30.0)")
 
 
 def test_a_ctrl_c_between_two_passes_of_spin_is_a_keyboard_interrupt(tmp_path: Path):
     # rclpy.spin's loop: the SIGINT lands in spin_once after its check for an earlier Ctrl-C and
     # before its check that the context is up; the handler has shut the context down, and that
     # check raised NotInitializedException ("rclpy.init() has not been called") out of spin
-    script = tmp_path / "interrupted_between_passes.py"
-    script.write_text(textwrap.dedent("""
+    _spin_interrupted(tmp_path / "interrupted_between_passes.py", """
         import signal
         import rclpy
         from aiorobot.compat._context import default_context
@@ -258,15 +263,4 @@ def test_a_ctrl_c_between_two_passes_of_spin_is_a_keyboard_interrupt(tmp_path: P
                 signal.raise_signal(signal.SIGINT)  # the handler runs as this call returns
 
         ctx.raise_if_interrupted = then_interrupted
-        try:
-            rclpy.spin(node)
-            print('spin returned', flush=True)
-        except KeyboardInterrupt:
-            print('interrupted, ok =', rclpy.ok(), flush=True)
-        rclpy.try_shutdown()
-        print('ended', flush=True)
-    """))
-    program = Program(str(script), exec_args=("--transport", "local"))
-    assert program.finish() == 0, program.output
-    assert "interrupted, ok = False" in program.output and "ended" in program.output, program.output
-    assert "Traceback" not in program.output, program.output
+    """, "rclpy.spin(node)")
