@@ -428,7 +428,12 @@ class Tap(Endpoint):
 
 
 class Subscription(Endpoint, Generic[M]):
-    """Receives messages of one topic into a QoS-bounded queue; a dispatcher runs the callback."""
+    """Receives messages of one topic into a QoS-bounded queue; a dispatcher runs the callback.
+
+    A message received from another process (zenoh, DDS, iceoryx2) while the dispatcher is idle
+    runs a plain-function callback (not ``async def``, its callback group free) in its delivery
+    instead, one loop turn sooner; ``asyncio.current_task()`` is then None in the callback
+    (docs/zenoh.md, "eager delivery")."""
 
     kind = "subscription"
     node: Node
