@@ -112,7 +112,8 @@ async def test_rosout_crosses_processes_and_is_recorded_by_bag_record(router_por
             assert (channel.topic, schema.name) == ("/rosout", "rcl_interfaces/msg/Log")
             lines.append((decoded.name, decoded.level, decoded.msg))
     # the lines logged before the recorder joined arrive too (transient local), then the live ones
-    assert ("robot.talker", 20, "started") in lines
+    # (the first lines in full when one is missing: seen once in CI, history from 'tick 1' on)
+    assert ("robot.talker", 20, "started") in lines, f"the history's first line is missing; the bag begins {lines[:8]}"
     assert ("camera", 30, "exposure clipped") in lines
     assert ("robot.talker", 40, "motor 2 over current") in lines
     assert sum(1 for name, _, text in lines if name == "robot.talker" and text.startswith("tick ")) >= 5
