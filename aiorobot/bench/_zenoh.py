@@ -406,7 +406,8 @@ class _Peer:
 
 
 def open_router(port: int) -> Any:
-    """A zenoh router session on ``tcp/127.0.0.1:<port>`` for the pairs (multicast scouting off)."""
+    """A zenoh router session on ``tcp/127.0.0.1:<port>`` (what ``aiorobot router`` runs; multicast
+    scouting off), for the bench's pairs and the transport tests."""
     import zenoh
 
     cfg = zenoh.Config()

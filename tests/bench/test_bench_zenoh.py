@@ -7,24 +7,14 @@ from __future__ import annotations
 
 import json
 import threading
-from collections.abc import Iterator
 
 import pytest
 
-from aiorobot.bench._zenoh import _free_port, _Peer, _Record, _round, _warm_up, available_paths, open_router
+from aiorobot.bench._zenoh import _Peer, _Record, _round, _warm_up, available_paths
+from tests.transport.conftest import router_port  # noqa: F401 - the transport tests' router fixture
 
 pytestmark = pytest.mark.timeout(90)
 _PATHS = [p for p, why in available_paths().items() if why is None and p != "dora-rs"]  # dora: test_bench_dora.py
-
-
-@pytest.fixture
-def router_port() -> Iterator[int]:
-    port = _free_port()
-    router = open_router(port)
-    try:
-        yield port
-    finally:
-        router.close()
 
 
 @pytest.mark.parametrize("path", _PATHS)

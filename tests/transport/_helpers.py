@@ -11,6 +11,7 @@ from collections.abc import Callable
 from typing import Any
 
 from aiorobot import Runtime
+from aiorobot.bench._zenoh import open_router  # the bench's: a router on loopback, multicast scouting off
 from aiorobot.transport import ZenohTransport
 
 __all__ = ["Child", "free_port", "open_router", "peer_env", "peer_runtime", "spawn", "wait_until"]
@@ -20,17 +21,6 @@ def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
-
-
-def open_router(port: int) -> Any:
-    """A zenoh router session on ``tcp/127.0.0.1:<port>`` (what ``aiorobot router`` runs)."""
-    import zenoh
-
-    cfg = zenoh.Config()
-    cfg.insert_json5("mode", '"router"')
-    cfg.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
-    cfg.insert_json5("scouting/multicast/enabled", "false")
-    return zenoh.open(cfg)
 
 
 def peer_env(folder: Any, port: int) -> dict[str, str]:
