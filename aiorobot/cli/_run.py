@@ -188,6 +188,7 @@ async def _serve_process(
 ) -> int:
     from aiorobot import Runtime
     from aiorobot.launch import ConfigError, node_configs, runtime_options
+    from aiorobot.launch._open import zenoh_options
     from aiorobot.lowlevel import set_on_failure
     from ._status import StatusDisplay
 
@@ -201,7 +202,9 @@ async def _serve_process(
     options = runtime_options(config)  # the Runtime arguments set by the [runtime] table
     # a multi-process graph (no zenoh_config of its own): the processes meet at the supervisor's endpoint
     if group.endpoints and not runtime_config.zenoh_config:
-        options["transport"] = make_transport("zenoh", domain_id=runtime_config.domain_id, **group.endpoints)
+        options["transport"] = make_transport(
+            "zenoh", domain_id=runtime_config.domain_id, **group.endpoints, **zenoh_options(config)
+        )
     async with Runtime(**options) as rt:
         # Signal handlers stay installed until the runtime has fully shut down: a second
         # Ctrl-C abandons what is blocked, a first one past shutdown_timeout too.

@@ -66,6 +66,7 @@ _RUNTIME_KEYS = (
     "record",
     "foxglove",
     "zenoh_config",
+    "iceoryx2_topics",
     "shutdown_timeout",
     "stall_threshold",
     "priority_stall_threshold",
@@ -113,6 +114,9 @@ class RuntimeConfig:
     stall_threshold: float = STALL_THRESHOLD_SEC
     priority_stall_threshold: float = PRIORITY_STALL_THRESHOLD_SEC
     late_threshold: float | None = LATE_THRESHOLD_SEC  # None (``false`` in the file): no culprit watch
+    # topics whose large messages go over iceoryx2 between this graph's processes (``"*"``: every
+    # topic of a type with arrays); ZenohTransport(iceoryx2_topics=)
+    iceoryx2_topics: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -367,6 +371,14 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
             check_session_file(zenoh_config)
         except ConfigError as err:
             raise checker.error("runtime.zenoh_config", str(err)) from None
+    iceoryx2_topics = table.get("iceoryx2_topics", [])
+    expected = 'a list of topic names, or ["*"] (every topic of a type with arrays)'
+    checker.check_type(iceoryx2_topics, "runtime.iceoryx2_topics", list, expected)
+    for topic in iceoryx2_topics:
+        if not isinstance(topic, str) or not topic.strip("/ "):
+            raise checker.error("runtime.iceoryx2_topics", f"expected {expected}, found {topic!r} in it")
+    if iceoryx2_topics and transport != "zenoh":
+        raise checker.error("runtime.iceoryx2_topics", 'only applies with transport = "zenoh"')
     seconds = {}
     for name, default in (
         ("shutdown_timeout", SHUTDOWN_TIMEOUT_SEC),
@@ -386,7 +398,7 @@ def _parse_runtime(checker: _Checker, table: Any, default_transport: str = "loca
     seconds["late_threshold"] = None if late is False else float(late)
     return RuntimeConfig(
         transport, domain_id, use_sim_time, strict_qos, log_level, realtime, debug_messages, parameters_file, zenoh_config,
-        **seconds
+        **seconds, iceoryx2_topics=tuple(iceoryx2_topics),
     )
 
 

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
     from .._core._node import Node
 
-__all__ = ["config_loader", "open_runtime", "runtime_options"]
+__all__ = ["config_loader", "open_runtime", "runtime_options", "zenoh_options"]
 
 #: the arguments of Runtime that a graph file's [runtime] table sets (the keys of runtime_options)
 _FILE_SETS = (
@@ -35,8 +35,8 @@ def runtime_options(config: GraphConfig) -> dict[str, Any]:
     """The keyword arguments of :class:`~aiorobot.Runtime` that ``config``'s ``[runtime]`` table sets."""
     rc = config.runtime
     transport: Any = rc.transport
-    if rc.zenoh_config:  # a zenoh session config file (routers, TLS, access control)
-        transport = make_transport("zenoh", domain_id=rc.domain_id, config_file=rc.zenoh_config)
+    if rc.zenoh_config or rc.iceoryx2_topics:  # a zenoh session config file (routers, TLS, access control)
+        transport = make_transport("zenoh", domain_id=rc.domain_id, config_file=rc.zenoh_config, **zenoh_options(config))
     return {
         "transport": transport,
         "domain_id": rc.domain_id,
@@ -49,6 +49,12 @@ def runtime_options(config: GraphConfig) -> dict[str, Any]:
         "priority_stall_threshold": rc.priority_stall_threshold,
         "late_threshold": rc.late_threshold,
     }
+
+
+def zenoh_options(config: GraphConfig) -> dict[str, Any]:
+    """The ZenohTransport arguments of ``config``'s ``[runtime]`` table besides its config file."""
+    topics = config.runtime.iceoryx2_topics
+    return {"iceoryx2_topics": list(topics)} if topics else {}
 
 
 def open_runtime(config: str | os.PathLike[str] | Path | GraphConfig, **kwargs: Any) -> Runtime:

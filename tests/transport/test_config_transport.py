@@ -34,3 +34,17 @@ async def test_a_graph_file_on_zenoh_reaches_another_process(router_port: int, t
     finally:
         child.terminate()
         await child.wait()
+
+
+def test_iceoryx2_topics_in_a_graph_file_reach_the_zenoh_transport(tmp_path: Path) -> None:
+    from aiorobot.launch import load_config, runtime_options
+
+    graph = tmp_path / "graph.toml"
+    graph.write_text(
+        '[runtime]\ntransport = "zenoh"\niceoryx2_topics = ["*", "/camera/depth"]\n'
+        '[[nodes]]\nname = "imu"\nuse = "aiorobot.examples.sensor:ImuPublisher"\n'
+    )
+    transport = runtime_options(load_config(graph))["transport"]
+    assert transport.iceoryx2_topics == {"*", "/camera/depth"}
+    graph.write_text('[runtime]\ntransport = "zenoh"\n[[nodes]]\nname = "imu"\nuse = "aiorobot.examples.sensor:ImuPublisher"\n')
+    assert runtime_options(load_config(graph))["transport"] == "zenoh"  # (the environment's, when the file says nothing)
