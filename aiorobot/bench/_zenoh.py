@@ -12,8 +12,8 @@ Paths (each one a sender process and a receiver process of its own):
   aiorobot's included;
 - ``iceoryx2``: iceoryx2 pub/sub with an event to wake the receiver, when ``iceoryx2`` is
   importable; the image written once into a loaned sample;
-- ``aiorobot-iox``: the ``aiorobot`` pair (domain 1, apart from it) with the image topic over the
-  iceoryx2 data path prototype (``aiorobot.transport._iceoryx2``), when ``iceoryx2`` is importable;
+- ``aiorobot-iox``: the ``aiorobot`` pair (domain 1, apart from it) with ``iceoryx2_topics=["*"]``:
+  the image over iceoryx2 (``aiorobot.transport._iceoryx2``), when ``iceoryx2`` is importable;
   its small messages and bursts go over zenoh as the ``aiorobot`` pair's do, so the table leaves
   them out;
 - ``dora-rs``: two dora-rs Python nodes, when ``dora`` is importable: the bench starts a dora
@@ -102,19 +102,15 @@ def _unstamp(data: Any) -> tuple[int, int]:
 
 
 async def _aiorobot_receiver(port: int, iceoryx2: bool = False) -> None:
-    """With ``iceoryx2``, the image over the iceoryx2 data path prototype (domain 1)."""
+    """With ``iceoryx2``, the image over iceoryx2 (domain 1)."""
     from .. import Node, QoSProfile, Runtime
     from ..msgs.geometry_msgs import Twist
     from ..msgs.sensor_msgs import Image
     from ..transport import ZenohTransport
 
     rec = _Record()
-    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"])
+    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"], iceoryx2_topics=_iox(iceoryx2))
     async with Runtime(transport=transport, handle_signals=False) as rt:
-        if iceoryx2:
-            from ..transport._iceoryx2 import Iceoryx2Receiver
-
-            Iceoryx2Receiver(transport, Image, "/bench/image", f"{_SERVICE}/{port}/aiorobot-image")
         node = rt.add_node(Node("bench_sink"))
         node.create_subscription(Twist, "/bench/twist", lambda m: rec.got(int(m.linear.y), int(m.linear.x)), QoSProfile(depth=10))
         node.create_subscription(
@@ -132,15 +128,11 @@ async def _aiorobot_sender(port: int, iceoryx2: bool = False) -> None:
     from ..msgs.sensor_msgs import Image
     from ..transport import ZenohTransport
 
-    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"])
+    transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"], iceoryx2_topics=_iox(iceoryx2))
     async with Runtime(transport=transport, handle_signals=False) as rt:
         node = rt.add_node(Node("bench_source"))
         twist = node.create_publisher(Twist, "/bench/twist", QoSProfile(depth=10))
         image = node.create_publisher(Image, "/bench/image", QoSProfile(depth=10))
-        if iceoryx2:
-            from ..transport._iceoryx2 import Iceoryx2Sender
-
-            Iceoryx2Sender(transport, Image, "/bench/image", f"{_SERVICE}/{port}/aiorobot-image", max_bytes=IMAGE_BYTES + 1024)
         data = np.zeros(IMAGE_BYTES, dtype=np.uint8)
 
         def small(kind: int) -> Twist:
@@ -152,6 +144,12 @@ async def _aiorobot_sender(port: int, iceoryx2: bool = False) -> None:
             return msg
 
         await _serve_stdin(_sender_commands((small, twist.publish), (picture, image.publish)))
+
+
+def _iox(iceoryx2: bool) -> list[str]:
+    """``iceoryx2_topics`` of an aiorobot peer: images over iceoryx2, or nothing (whatever the
+    environment says)."""
+    return ["*"] if iceoryx2 else []
 
 
 async def _zenoh_receiver(port: int, service: str = _SERVICE, hop: bool = False) -> None:
@@ -569,7 +567,7 @@ def table(part: dict[str, Any]) -> Any:
         "zenoh-loop": "bare zenoh-python -> asyncio loop",
         "iceoryx2": "iceoryx2 pub/sub + event",
         "dora-rs": "dora-rs, two Python dynamic nodes",
-        "aiorobot-iox": "aiorobot + iceoryx2 data path (prototype)",
+        "aiorobot-iox": "aiorobot + iceoryx2_topics=[\"*\"]",
     }
     for path, fig in part.get("paths", {}).items():
         if "error" in fig:

@@ -29,6 +29,7 @@ import itertools
 import json
 import logging
 import os
+import struct
 import threading
 import time
 from collections import Counter, deque
@@ -107,6 +108,11 @@ BACKLOG_LIMIT = 10_000
 #: (fewer when the topic's smallest depth is smaller), and of all topics together
 MAX_CHUNK = 64
 MAX_DRAIN = 256
+#: a topic received over iceoryx2 and zenoh both delivers each (publisher, sequence number) once
+#: among this many of the publisher's newest
+WINDOW = 256
+_WINDOW_BITS = (1 << WINDOW) - 1
+_SEQ = struct.Struct("<q")
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
 
@@ -140,6 +146,10 @@ class TransportStatistics:
     #: connect endpoints the session could not link to when it opened (each one warned about,
     #: except the default router of a session that has peer endpoints of its own)
     connect_failures: int = 0
+    #: messages sent over iceoryx2 to processes on this host (``iceoryx2_topics``), not counted in ``sent``
+    sent_iceoryx2: int = 0
+    #: messages received over iceoryx2, not counted in ``received``
+    received_iceoryx2: int = 0
 
 
 class _Owner:
@@ -275,6 +285,7 @@ class _Outbound:
         self.transport = transport
         self.topic = topic
         self.msg_type = msg_type
+        self.type_hash = type_hash
         self.key = data_key(transport.domain_id, topic, msg_type.__msgtype__, type_hash)
         self.publishers: list[Publisher[Any]] = []
         self._tail = attachment_tail(b"\0" * 16)
@@ -283,12 +294,16 @@ class _Outbound:
         self.advanced = False
         self.matched = False  # a remote subscriber matches the key (kept by zenoh's matching listener)
         self.depth = 0
+        self.iox: Any = None  # the iceoryx2 sender (iceoryx2_topics)
+        # a remote subscription of the topic is not served over iceoryx2: large messages go over zenoh too
+        self.zenoh_needed = True
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>", keeps=False)
         self.tap.hidden = True  # type: ignore[attr-defined]
 
     def set_gid(self, gid: bytes) -> None:
         """The GID every put's attachment carries (that of the topic's first local publisher)."""
         self._tail = attachment_tail(gid)
+        self.transport._own_gids.add(gid)
 
     def declare(self, qos: QoSProfile) -> None:
         """(Re)declare the zenoh publisher so it serves ``qos`` (a cache for transient local)."""
@@ -346,6 +361,10 @@ class _Outbound:
         zpub = self.zpub
         if zpub is None or transport._local.injecting:
             return  # closed, or it came from the network: do not echo it back
+        iox = self.iox
+        if iox is not None and iox.wanted():
+            self._send_iceoryx2(msg, iox, zpub)
+            return
         if not self.matched and not zpub.matching_status.matching:
             return  # no remote subscriber (asked, as the listener's word may still be on its way)
         try:
@@ -357,10 +376,67 @@ class _Outbound:
         zpub.put(data if len(data) < transport._shm_from else transport._payload(data), attachment=attachment)
         transport._sent += 1
 
+    def _send_iceoryx2(self, msg: Any, iox: Any, zpub: Any) -> None:
+        """A message of a topic with an iceoryx2 input of another process connected: a large one
+        goes over iceoryx2, and over zenoh only for remote subscriptions that path does not serve."""
+        transport = self.transport
+        try:
+            parts, size = iox.serialize(msg)
+        except (TypeError, ValueError) as err:
+            transport._warn("serialize", f"cannot send a message on {self.topic}: {err}")
+            return
+        attachment = attachment_head(next(self._seq), time.time_ns()) + self._tail
+        if size >= transport._shm_threshold:
+            why = iox.send(attachment, parts, size)
+            if why is None:
+                transport._sent_iox += 1
+                if not self.zenoh_needed:
+                    return
+            else:  # it goes over zenoh, as to any other subscriber
+                transport._warn("iceoryx2", f"cannot send a message on {self.topic} over iceoryx2 ({why}): sent over zenoh")
+        if not self.matched and not zpub.matching_status.matching:
+            return
+        data = b"".join(parts)
+        zpub.put(data if len(data) < transport._shm_from else transport._payload(data), attachment=attachment)
+        transport._sent += 1
+
     def close(self) -> None:
         if self.zpub is not None:
             self.zpub.undeclare()
             self.zpub = None
+        if self.iox is not None:
+            self.iox.close()
+            self.iox = None
+
+
+class Delivered:
+    """Which messages of each publisher were delivered, by sequence number: a topic received over
+    iceoryx2 and zenoh both delivers each message once (the copy that comes second is dropped).
+    The ``WINDOW`` newest numbers of each publisher are remembered; an older one counts as
+    delivered."""
+
+    def __init__(self) -> None:
+        self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits]
+
+    def seen(self, gid: bytes, seq: int) -> bool:
+        """Whether ``seq`` of ``gid`` was delivered already; if not, it is from now on."""
+        entry = self._by_gid.get(gid)
+        if entry is None:
+            self._by_gid[gid] = [seq, 1]
+            return False
+        newest, bits = entry
+        if seq > newest:
+            shift = seq - newest
+            entry[0], entry[1] = seq, ((bits << shift) | 1) & _WINDOW_BITS if shift < WINDOW else 1
+            return False
+        back = newest - seq
+        if back >= WINDOW or bits >> back & 1:
+            return True
+        entry[1] = bits | 1 << back
+        return False
+
+    def forget(self, gid: bytes) -> None:
+        self._by_gid.pop(gid, None)
 
 
 class _Inbound:
@@ -388,6 +464,9 @@ class _Inbound:
         self._gid = b""
         self.inbox: _Inbox | None = None  # the loop's that delivers it; None: the main loop's
         self.decode = decoder(msg_type, view=True)  # received messages: arrays are read-only views
+        self.iox: Any = None  # the iceoryx2 input (iceoryx2_topics): messages may arrive both ways
+        self._iox_token: Any = None
+        self._delivered = Delivered()
 
     def add(self, sub: Any) -> None:
         self.subscriptions.append(sub)
@@ -460,10 +539,16 @@ class _Inbound:
             transport._drop_sample(key, err)
             return None
         transport._received += 1
+        if self.iox is not None:
+            return gid, msg, _SEQ.unpack_from(att)[0]
         return gid, msg
 
-    def _inject(self, gid: bytes, msg: Any) -> None:
-        """On the main loop: publish a received message into the bus as its remote publisher."""
+
+    def _inject(self, gid: bytes, msg: Any, seq: int | None = None) -> None:
+        """On the main loop: publish a received message into the bus as its remote publisher
+        (``seq``: its sequence number, when it may arrive over iceoryx2 and zenoh both)."""
+        if seq is not None and self._delivered.seen(gid, seq):
+            return
         injector = self._injector
         if gid != self._gid or injector is None or injector.destroyed:
             injector = self.transport._by_gid.get(gid)
@@ -483,6 +568,12 @@ class _Inbound:
             local.injecting = False
 
     def close(self) -> None:
+        if self._iox_token is not None:
+            self._iox_token.undeclare()
+            self._iox_token = None
+        if self.iox is not None:
+            self.iox.close()
+            self.iox = None
         if self.zsub is not None:
             self.zsub.undeclare()
             self.zsub = None
@@ -605,13 +696,17 @@ class ZenohTransport(Transport):
         2 KiB) is put from a shared-memory pool (``ZENOH_SHM_ALLOC_SIZE``, 48 MiB), as
         rmw_zenoh does: a peer on this host maps it instead of receiving it over the socket.
     iceoryx2_topics
-        Topics whose data goes over iceoryx2's shared memory between aiorobot processes on this
-        host, serialised straight into a loaned sample (one copy of an image end to end, against
-        three over zenoh); discovery, the graph and every other topic stay on zenoh. Every process
-        of such a topic must list it (``AIOROBOT_ICEORYX2_TOPICS=/a,/b`` when this is None): its
-        subscriptions here then receive only over iceoryx2 (not from other hosts or rmw_zenoh
-        nodes), while its publishers still reach zenoh subscribers too. Needs ``iceoryx2``
-        (``pip install iceoryx2``). See docs/zenoh.md.
+        Topics whose large messages (``shm_threshold`` bytes of CDR or more) go over iceoryx2's
+        shared memory between aiorobot processes on this host, serialised straight into a loaned
+        sample (one copy of an image end to end, against three over zenoh); ``"*"`` is every
+        topic whose type carries an unbounded array of numbers (images, point clouds, scans).
+        ``AIOROBOT_ICEORYX2_TOPICS=/a,/b`` (or ``*``) when this is None. Discovery, the graph,
+        small messages and everything else stay on zenoh. A subscribing process announces its
+        iceoryx2 input over zenoh; a publisher whose remote subscribers are all served that way
+        sends large messages over iceoryx2 only, and to any other (another host, an rmw_zenoh
+        node, a process without the topic listed) over zenoh as before; a message that arrives
+        both ways is delivered once. Needs ``iceoryx2`` (``pip install aiorobot[iceoryx2]``).
+        See docs/zenoh.md.
     """
 
     name = "zenoh"
@@ -631,8 +726,16 @@ class ZenohTransport(Transport):
         self.allow_plain = tuple(allow_plain)
         if iceoryx2_topics is None:
             iceoryx2_topics = os.environ.get("AIOROBOT_ICEORYX2_TOPICS", "").split(",")
-        self.iceoryx2_topics = frozenset("/" + t.strip().strip("/") for t in iceoryx2_topics if t.strip().strip("/"))
-        self._iox_senders: dict[tuple[str, str], Any] = {}
+        self.iceoryx2_topics = frozenset(
+            t.strip() if t.strip() == "*" else "/" + t.strip().strip("/") for t in iceoryx2_topics if t.strip().strip("/")
+        )
+        self._iox: Any = None  # the iceoryx2 node (Iceoryx2Host) while open, when iceoryx2_topics names any
+        self._iox_sub: Any = None  # the liveliness subscriber of other processes' iceoryx2 inputs
+        self._iox_inputs: dict[tuple[str, str], dict[str, int]] = {}  # (topic, hash) -> session -> its iceoryx2 node
+        self._sub_zids: dict[tuple[str, str], Counter[str]] = {}  # (topic, hash) -> remote subscriptions per session
+        self._own_gids: set[bytes] = set()
+        self._sent_iox = 0
+        self._received_iox = 0
         self._connect_failures = 0
         self.config_file = config_file
         self.connect = connect
@@ -714,6 +817,20 @@ class ZenohTransport(Transport):
         self._liveliness_sub = self._session.liveliness().declare_subscriber(
             f"@ros2_lv/{self.domain_id}/**", self._on_token, history=True
         )
+        if self.iceoryx2_topics:
+            from ._iceoryx2 import TOKEN_PREFIX, Iceoryx2Host
+
+            try:
+                self._iox = Iceoryx2Host()
+            except Exception as err:  # noqa: BLE001 - no shared memory here: everything over zenoh, said once
+                _log.warning(
+                    f"iceoryx2_topics: iceoryx2 could not open a node ({type(err).__name__}: {err}); "
+                    f"{', '.join(sorted(self.iceoryx2_topics))} go over zenoh"
+                )
+            else:
+                self._iox_sub = self._session.liveliness().declare_subscriber(
+                    f"{TOKEN_PREFIX}/{self.domain_id}/**", self._on_iox_token, history=True
+                )
         await asyncio.to_thread(self._report_unlinked, plan)
 
     def _peers_chosen(self, plan: SessionPlan) -> bool:
@@ -754,6 +871,9 @@ class ZenohTransport(Transport):
             return
         if self._liveliness_sub is not None:
             self._liveliness_sub.undeclare()
+        if self._iox_sub is not None:
+            self._iox_sub.undeclare()
+            self._iox_sub = None
         bus = self.bus
         with self._lock:
             for token in list(self._remote):
@@ -762,9 +882,6 @@ class ZenohTransport(Transport):
                 if bus is not None:
                     bus.remove(out.tap)
                 out.close()
-            for sender in self._iox_senders.values():
-                sender.close()
-            self._iox_senders.clear()
             for inb in self._inbound.values():
                 if bus is not None:
                     bus.remove(inb.fallback)
@@ -780,6 +897,11 @@ class ZenohTransport(Transport):
             self._queryables.clear()
             self._tokens.clear()
             self._nodes.clear()
+            self._iox_inputs.clear()
+            self._sub_zids.clear()
+            if self._iox is not None:
+                self._iox.close()
+                self._iox = None
         if bus is not None and getattr(bus.services, "listener", None) is self:
             bus.services.listener = None  # type: ignore[attr-defined]
         self._session = None
@@ -793,7 +915,7 @@ class ZenohTransport(Transport):
     def statistics(self) -> TransportStatistics:
         return TransportStatistics(
             self._sent, self._received, sum(self._drops.values()), dict(self._drops), len(self._remote_nodes),
-            self._sent_shm, self._received_shm, self._connect_failures,
+            self._sent_shm, self._received_shm, self._connect_failures, self._sent_iox, self._received_iox,
         )
 
     def remote_nodes(self) -> tuple[NodeInfo, ...]:
@@ -894,6 +1016,86 @@ class ZenohTransport(Transport):
         """The iceoryx2 service of ``topic`` in this domain (every process on the host derives it)."""
         return f"aiorobot/{self.domain_id}/{topic.strip('/')}/{type_hash}"
 
+    def _iceoryx2_for(self, topic: str, msg_type: Any) -> bool:
+        """Whether ``topic``'s large messages take the iceoryx2 path here (``iceoryx2_topics``)."""
+        if self._iox is None:
+            return False
+        if topic in self.iceoryx2_topics:
+            return True
+        if "*" not in self.iceoryx2_topics:
+            return False
+        from ._iceoryx2 import carries_arrays
+
+        return carries_arrays(msg_type)
+
+    def _open_iox_input(self, inb: _Inbound) -> None:
+        """Receive ``inb``'s topic over iceoryx2 too, and say so to the other processes (the
+        token after the subscriber: a publisher that sees it finds the subscriber connected)."""
+        from ._iceoryx2 import Iceoryx2Input, token_key
+
+        try:
+            inb.iox = Iceoryx2Input(self._iox, inb, self._iceoryx2_service(inb.topic, inb.type_hash))
+        except Exception as err:  # noqa: BLE001 - the service is full, or made by another version
+            self._iox_refused(inb.topic, "receive", err)
+            return
+        inb._iox_token = self._session.liveliness().declare_token(
+            token_key(self.domain_id, self._zid, self._iox.node_id, inb.topic, inb.type_hash)
+        )
+        out = self._outbound.get((inb.topic, inb.msg_type.__msgtype__))
+        if out is not None and out.iox is not None:
+            out.iox.own = 1
+
+    def _iox_refused(self, topic: str, what: str, err: Exception) -> None:
+        _log.warning(
+            f"iceoryx2_topics: cannot {what} {topic} over iceoryx2 ({type(err).__name__}: {err}); "
+            "it goes over zenoh in this process"
+        )
+
+    def _on_iox_token(self, sample: Any) -> None:
+        import zenoh
+
+        self._to_loop(self._iox_token_event, str(sample.key_expr), sample.kind == zenoh.SampleKind.PUT)
+
+    def _iox_token_event(self, token: str, alive: bool) -> None:
+        """On the main loop: another process's iceoryx2 input appeared or left."""
+        from ._iceoryx2 import parse_token
+
+        if self._iox is None:
+            return
+        try:
+            zid, node_id, topic, type_hash = parse_token(token)
+        except ValueError as err:
+            self._warn("token", f"ignored an iceoryx2 token: {err}")
+            return
+        if zid == self._zid:
+            return
+        key = (topic, type_hash)
+        with self._lock:
+            inputs = self._iox_inputs.setdefault(key, {})
+            if alive:
+                inputs[zid] = node_id
+            else:
+                inputs.pop(zid, None)
+                self._iox.cleanup()  # a process killed with SIGKILL leaves its ports counted
+            self._refresh_iox(key)
+
+    def _refresh_iox(self, key: tuple[str, str]) -> None:
+        """Whether large messages of the topic ``key`` (topic, hash) must go over zenoh too: a
+        remote subscription there is not served over iceoryx2, or none is known yet. Served: its
+        session announced an input whose iceoryx2 node is attached to the topic's service, which
+        proves it maps this host's shared memory (a node elsewhere is not in the list)."""
+        topic, type_hash = key
+        for (name, _), out in self._outbound.items():
+            if name != topic or out.iox is None or out.type_hash != type_hash:
+                continue
+            zids = self._sub_zids.get(key)
+            if not zids:
+                out.zenoh_needed = True
+                continue
+            inputs = self._iox_inputs.get(key, {})
+            service = self._iceoryx2_service(topic, type_hash)
+            out.zenoh_needed = not all(z in inputs and self._iox.attached(service, inputs[z]) for z in zids)
+
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)
         if cached is None:
@@ -972,9 +1174,6 @@ class ZenohTransport(Transport):
                         if self.bus is not None:
                             self.bus.remove(out.tap)
                         out.close()
-                        sender = self._iox_senders.pop((out.topic, endpoint.type_name), None)
-                        if sender is not None:
-                            sender.close()
             elif isinstance(endpoint, (Subscription, Tap)):
                 inb = self._inbound.get((endpoint.topic_name, endpoint.type_name))
                 if inb is not None and endpoint in inb.subscriptions:
@@ -984,6 +1183,9 @@ class ZenohTransport(Transport):
                         if self.bus is not None:
                             self.bus.remove(inb.fallback)
                         inb.close()
+                        out = self._outbound.get((inb.topic, endpoint.type_name))
+                        if out is not None and out.iox is not None:
+                            out.iox.own = 0
             elif isinstance(endpoint, Service):
                 q = self._queryables.pop(id(endpoint), None)
                 if q is not None:
@@ -1002,30 +1204,35 @@ class ZenohTransport(Transport):
         out.publishers.append(pub)
         if new and self.bus is not None:
             self.bus.add_subscription(out.tap)
-            if pub.topic_name in self.iceoryx2_topics:
-                from ._iceoryx2 import INITIAL_BYTES, Iceoryx2Sender
+        if out.iox is None and not out.advanced and self._iceoryx2_for(pub.topic_name, pub.msg_type):
+            # (an advanced publisher's cache must get every message over zenoh: it stays there)
+            from ._iceoryx2 import Iceoryx2Sender
 
-                self._iox_senders[key] = Iceoryx2Sender(
-                    self, pub.msg_type, pub.topic_name, self._iceoryx2_service(pub.topic_name, type_hash),
-                    max_bytes=INITIAL_BYTES,
-                )
+            try:
+                out.iox = Iceoryx2Sender(self._iox, out, self._iceoryx2_service(pub.topic_name, type_hash))
+            except Exception as err:  # noqa: BLE001 - the service is full, or made by another version
+                self._iox_refused(pub.topic_name, "publish", err)
+                return
+            inb = self._inbound.get(key)
+            out.iox.own = int(inb is not None and inb.iox is not None)
+            self._refresh_iox((pub.topic_name, type_hash))
+        elif out.iox is not None and out.advanced:
+            out.iox.close()
+            out.iox = None
 
     def _add_subscription(self, sub: Subscription[Any]) -> None:
         type_hash = self._hash(sub.msg_type)
         key = (sub.topic_name, sub.type_name)
         inb = self._inbound.get(key)
         new = inb is None
-        if inb is None and sub.topic_name in self.iceoryx2_topics:
-            from ._iceoryx2 import Iceoryx2Receiver  # (it takes its place in _inbound, fallback added)
-
-            inb = Iceoryx2Receiver(self, sub.msg_type, sub.topic_name, self._iceoryx2_service(sub.topic_name, type_hash))
-            new = False
-        elif inb is None:
+        if inb is None:
             inb = self._inbound[key] = _Inbound(self, sub.topic_name, sub.msg_type, type_hash)
         inb.add(sub)
         if new and self.bus is not None:
             self.bus.add_publisher(inb.fallback)
         inb.declare(sub.qos)
+        if new and self._iceoryx2_for(sub.topic_name, sub.msg_type):
+            self._open_iox_input(inb)
         # The zenoh subscriber first, then the liveliness token (as rmw_zenoh): a publisher that sees the
         # token, and so counts the subscription as matched, finds the route to it already declared.
         if sub.node is not None:  # the runtime's /clock tap has no node: it receives without a graph entry
@@ -1204,6 +1411,9 @@ class ZenohTransport(Transport):
             tap = Tap(cls, info.topic, info.qos, _ignore, owner=info.node_fqn, keeps=False)
             self._remote[info.token] = tap
             self._add_to_bus(tap)
+            key = (info.topic, info.type_hash)
+            self._sub_zids.setdefault(key, Counter())[info.zid] += 1
+            self._refresh_iox(key)
         elif info.kind == "SS":
             if info.topic == f"{info.node_fqn.rstrip('/')}/get_type_description":
                 self._describers.add(info.node_fqn)
@@ -1334,11 +1544,22 @@ class ZenohTransport(Transport):
         if entry is None or bus is None:
             return
         if isinstance(entry, _Injector):
-            self._by_gid.pop(gid_of(token), None)
+            gid = gid_of(token)
+            self._by_gid.pop(gid, None)
+            inb = self._inbound.get((entry.topic_name, entry.type_name))
+            if inb is not None:
+                inb._delivered.forget(gid)
             entry.destroyed = True
             bus.remove(entry)
         elif isinstance(entry, Tap):
             bus.remove(entry)
+            info = parse_token(token)
+            zids = self._sub_zids.get((info.topic, info.type_hash))
+            if zids is not None:
+                zids[info.zid] -= 1
+                if zids[info.zid] <= 0:
+                    del zids[info.zid]
+                self._refresh_iox((info.topic, info.type_hash))
         else:
             entry.destroyed = True
             bus.services.remove(entry)

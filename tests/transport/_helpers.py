@@ -90,18 +90,24 @@ async def stdin_lines():
 """
 
 
-async def spawn(code: str, port: int, *, domain_id: int = 0) -> Child:
-    """Run ``code`` (an ``async def main(rt)`` body's module) in a child with a zenoh runtime."""
+async def spawn(code: str, port: int, *, domain_id: int = 0, env: dict[str, str | None] | None = None) -> Child:
+    """Run ``code`` (an ``async def main(rt)`` body's module) in a child with a zenoh runtime
+    (``env``: variables set, or unset when None, over this process's environment)."""
     script = PRELUDE + textwrap.dedent(code) + textwrap.dedent(f"""
         async def _entry():
             async with Runtime(transport=ZenohTransport(domain_id={domain_id}, connect=["tcp/127.0.0.1:{port}"]), handle_signals=False) as rt:
                 await main(rt)
         aiorobot.run(_entry())
         """)
-    env = dict(os.environ)
-    env.pop("ZENOH_CONFIG_OVERRIDE", None)
+    environ = dict(os.environ)
+    environ.pop("ZENOH_CONFIG_OVERRIDE", None)
+    for name, value in (env or {}).items():
+        if value is None:
+            environ.pop(name, None)
+        else:
+            environ[name] = value
     proc = await asyncio.create_subprocess_exec(
         sys.executable, "-c", script,
-        stdin=asyncio.subprocess.PIPE, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE, env=env,
+        stdin=asyncio.subprocess.PIPE, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE, env=environ,
     )
     return Child(proc)

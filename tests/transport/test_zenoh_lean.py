@@ -253,3 +253,19 @@ async def test_a_callback_run_on_arrival_publishes_to_other_processes(router_por
             await wait_until(lambda: [x for x in heard if x >= 0] == list(range(20)))
         assert [x for x in relayed if x >= 0] == list(range(20))
         child.send("bye")
+
+
+def test_delivered_passes_each_publisher_s_sequence_number_once_out_of_order_within_its_window() -> None:
+    """A topic received over iceoryx2 and zenoh both: the copy that comes second is dropped."""
+    from aiorobot.transport._zenoh import WINDOW, Delivered
+
+    a, b = b"a" * 16, b"b" * 16
+    d = Delivered()
+    assert [d.seen(a, s) for s in (1, 2, 2, 1)] == [False, False, True, True]
+    assert [d.seen(a, s) for s in (5, 3, 4, 5, 3)] == [False, False, False, True, True]  # 3 and 4 came late
+    assert not d.seen(b, 2) and d.seen(b, 2) and not d.seen(a, 6)  # publishers apart
+    newest = 6 + WINDOW + 10
+    assert not d.seen(a, newest)
+    assert d.seen(a, newest - WINDOW) and not d.seen(a, newest - WINDOW + 1)  # out of the window: delivered
+    d.forget(a)
+    assert not d.seen(a, 1)  # (a publisher gone: its numbers forgotten)
