@@ -272,7 +272,7 @@ class Iceoryx2Input:
                 if not self._stop.is_set():
                     transport._warn("iceoryx2", f"receiving {inbound.topic} over iceoryx2: {type(err).__name__}: {err}")
 
-    def _decode(self, sample: Any) -> tuple[bytes, Any, int] | None:
+    def _decode(self, sample: Any) -> tuple[bytes, Any, int, bool] | None:
         """On the receiving thread: ``(gid, message, sequence number)``, the message's arrays
         viewing the sample; None for this process's own messages and for what is dropped."""
         transport = self.transport
@@ -303,7 +303,7 @@ class Iceoryx2Input:
             return None
         transport._received_iox += 1
         self.received += 1
-        return gid, msg, _SEQ.unpack_from(head)[0]
+        return gid, msg, _SEQ.unpack_from(head)[0], True
 
     def _released(self) -> None:
         with self._held_lock:

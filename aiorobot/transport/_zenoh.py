@@ -6,11 +6,14 @@
   subscriber matches). Same-process subscribers keep zero-copy delivery: they never
   see the tap.
 * A local subscription gets a token; its topic gets one zenoh subscriber (an
-  advanced one with history for transient local). zenoh's thread queues each sample
-  (one queue, arrival order) and wakes the main loop once per batch; there samples
-  are checked (key, type hash, attachment, CDR), decoded (arrays as views into the
-  payload) and published into the bus by an *injector* (a publisher standing for the
-  remote one), a topic's depth at most per loop turn.
+  advanced one with history for transient local). zenoh's thread checks each sample
+  (key, type hash, attachment, CDR) and decodes it (arrays as views into the payload),
+  queues it in the inbox of the loop the topic's subscriptions run on (arrival order)
+  and wakes that loop once per batch; there it is published into the bus by an
+  *injector* (a publisher standing for the remote one), a topic's depth at most per
+  loop turn, and an idle subscription's plain-function callback runs right then.
+* ``iceoryx2_topics``: large messages between processes on one host go over
+  iceoryx2 beside zenoh (:mod:`aiorobot.transport._iceoryx2`).
 * Remote endpoints learnt from liveliness tokens join the bus as endpoints of their
   own (injectors for publishers, passive taps for subscriptions, remote servers and
   clients for services), so ``Runtime.graph``, ``count_subscribers``,
@@ -413,25 +416,30 @@ class Delivered:
     """Which messages of each publisher were delivered, by sequence number: a topic received over
     iceoryx2 and zenoh both delivers each message once (the copy that comes second is dropped).
     The ``WINDOW`` newest numbers of each publisher are remembered; an older one counts as
-    delivered."""
+    delivered. Only a publisher that has sent over iceoryx2 has its zenoh messages dropped as
+    copies: one that sends over zenoh alone (an rmw_zenoh node, another host) is never second-guessed
+    on its sequence numbers."""
 
     def __init__(self) -> None:
-        self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits]
+        self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits, over iceoryx2]
 
-    def seen(self, gid: bytes, seq: int) -> bool:
-        """Whether ``seq`` of ``gid`` was delivered already; if not, it is from now on."""
+    def seen(self, gid: bytes, seq: int, iceoryx2: bool = False) -> bool:
+        """Whether ``seq`` of ``gid`` (which came over iceoryx2, or zenoh) was delivered already;
+        if not, it is from now on."""
         entry = self._by_gid.get(gid)
         if entry is None:
-            self._by_gid[gid] = [seq, 1]
+            self._by_gid[gid] = [seq, 1, iceoryx2]
             return False
-        newest, bits = entry
+        if iceoryx2:
+            entry[2] = True
+        newest, bits, both = entry
         if seq > newest:
             shift = seq - newest
             entry[0], entry[1] = seq, ((bits << shift) | 1) & _WINDOW_BITS if shift < WINDOW else 1
             return False
         back = newest - seq
         if back >= WINDOW or bits >> back & 1:
-            return True
+            return bool(both)
         entry[1] = bits | 1 << back
         return False
 
@@ -442,9 +450,9 @@ class Delivered:
 class _Inbound:
     """One topic's zenoh subscriber; hands checked, decoded messages to the bus.
 
-    zenoh's thread checks and decodes a sample and queues the message in the transport's one
-    queue (all topics, in arrival order); :meth:`ZenohTransport._drain` injects them on the
-    main loop.
+    zenoh's thread (and the iceoryx2 input's, for ``iceoryx2_topics``) checks and decodes a
+    sample and queues the message in the inbox of the loop the topic's subscriptions run on
+    (all topics, in arrival order); :meth:`_Inbox.drain` injects them there.
     """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
@@ -544,10 +552,10 @@ class _Inbound:
         return gid, msg
 
 
-    def _inject(self, gid: bytes, msg: Any, seq: int | None = None) -> None:
+    def _inject(self, gid: bytes, msg: Any, seq: int | None = None, iceoryx2: bool = False) -> None:
         """On the main loop: publish a received message into the bus as its remote publisher
         (``seq``: its sequence number, when it may arrive over iceoryx2 and zenoh both)."""
-        if seq is not None and self._delivered.seen(gid, seq):
+        if seq is not None and self._delivered.seen(gid, seq, iceoryx2):
             return
         injector = self._injector
         if gid != self._gid or injector is None or injector.destroyed:

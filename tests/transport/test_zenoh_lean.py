@@ -259,13 +259,19 @@ def test_delivered_passes_each_publisher_s_sequence_number_once_out_of_order_wit
     """A topic received over iceoryx2 and zenoh both: the copy that comes second is dropped."""
     from aiorobot.transport._zenoh import WINDOW, Delivered
 
-    a, b = b"a" * 16, b"b" * 16
+    a, b, c = b"a" * 16, b"b" * 16, b"c" * 16
     d = Delivered()
-    assert [d.seen(a, s) for s in (1, 2, 2, 1)] == [False, False, True, True]
-    assert [d.seen(a, s) for s in (5, 3, 4, 5, 3)] == [False, False, False, True, True]  # 3 and 4 came late
-    assert not d.seen(b, 2) and d.seen(b, 2) and not d.seen(a, 6)  # publishers apart
-    newest = 6 + WINDOW + 10
-    assert not d.seen(a, newest)
+    assert [d.seen(a, s, True) for s in (1, 2)] == [False, False]
+    assert [d.seen(a, s) for s in (2, 1, 3)] == [True, True, False]  # zenoh's copies of 1 and 2; 3 came first
+    assert d.seen(a, 3, True)  # ... so iceoryx2's copy of 3 is the second
+    assert [d.seen(a, s, True) for s in (6, 4, 5, 6)] == [False, False, False, True]  # 4 and 5 came late
+    assert [d.seen(a, s) for s in (4, 5)] == [True, True]
+    assert not d.seen(b, 2, True) and d.seen(b, 2) and not d.seen(a, 7)  # publishers apart
+    newest = 7 + WINDOW + 10
+    assert not d.seen(a, newest, True)
     assert d.seen(a, newest - WINDOW) and not d.seen(a, newest - WINDOW + 1)  # out of the window: delivered
+    # a publisher never seen over iceoryx2 (rmw_zenoh, another host) is not second-guessed on its numbers
+    assert [d.seen(c, s) for s in (5, 5, 1, 5)] == [False, False, False, False]
+    assert d.seen(c, 5, True)  # (once it sends over iceoryx2, a number delivered over zenoh is a copy)
     d.forget(a)
     assert not d.seen(a, 1)  # (a publisher gone: its numbers forgotten)
