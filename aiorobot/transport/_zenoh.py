@@ -114,7 +114,6 @@ MAX_DRAIN = 256
 #: a topic received over iceoryx2 and zenoh both delivers each (publisher, sequence number) once
 #: among this many of the publisher's newest
 WINDOW = 256
-_WINDOW_BITS = (1 << WINDOW) - 1
 _SEQ = struct.Struct("<q")
 _ANY_QOS = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT, depth=1)
 _FALLBACK_QOS = QoSProfile(durability=DurabilityPolicy.TRANSIENT_LOCAL, depth=1)
@@ -415,13 +414,14 @@ class _Outbound:
 class Delivered:
     """Which messages of each publisher were delivered, by sequence number: a topic received over
     iceoryx2 and zenoh both delivers each message once (the copy that comes second is dropped).
-    The ``WINDOW`` newest numbers of each publisher are remembered; an older one counts as
-    delivered. Only a publisher that has sent over iceoryx2 has its zenoh messages dropped as
+    The ``window`` newest numbers of each publisher are remembered (``WINDOW`` at least; a
+    transient-local topic's depth); an older one counts as delivered. Only a publisher that has sent over iceoryx2 has its zenoh messages dropped as
     copies: one that sends over zenoh alone (an rmw_zenoh node, another host) is never second-guessed
     on its sequence numbers."""
 
-    def __init__(self) -> None:
+    def __init__(self, window: int = 0) -> None:
         self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits, over iceoryx2]
+        self.window = max(window, WINDOW)
 
     def seen(self, gid: bytes, seq: int, iceoryx2: bool = False) -> bool:
         """Whether ``seq`` of ``gid`` (which came over iceoryx2, or zenoh) was delivered already;
@@ -433,15 +433,21 @@ class Delivered:
         if iceoryx2:
             entry[2] = True
         newest, bits, both = entry
+        window = self.window
         if seq > newest:
             shift = seq - newest
-            entry[0], entry[1] = seq, ((bits << shift) | 1) & _WINDOW_BITS if shift < WINDOW else 1
+            entry[0], entry[1] = seq, ((bits << shift) | 1) & ((1 << window) - 1) if shift < window else 1
             return False
         back = newest - seq
-        if back >= WINDOW or bits >> back & 1:
+        if back >= window or bits >> back & 1:
             return bool(both)
         entry[1] = bits | 1 << back
         return False
+
+    def newest(self, gid: bytes) -> int | None:
+        """The newest sequence number of ``gid`` delivered (None: none yet)."""
+        entry = self._by_gid.get(gid)
+        return None if entry is None else entry[0]
 
     def forget(self, gid: bytes) -> None:
         self._by_gid.pop(gid, None)
@@ -475,6 +481,7 @@ class _Inbound:
         self.iox: Any = None  # the iceoryx2 input (iceoryx2_topics): messages may arrive both ways
         self._iox_token: Any = None
         self._delivered = Delivered()
+        self._history_asked: set[str] = set()  # sessions whose publishers' caches this inbound queried
 
     def add(self, sub: Any) -> None:
         self.subscriptions.append(sub)
@@ -500,9 +507,11 @@ class _Inbound:
             return
         old = self.zsub
         self.depth = max(depth, self.depth)
+        self._delivered.window = max(self._delivered.window, self.depth)
         key = self.prefix + "/*"  # any hash: a mismatch is reported, not silently missed
         if want_history or self.advanced:
             reliable = qos.reliability is ReliabilityPolicy.RELIABLE
+            self.advanced = True  # (before: its history may arrive while it is being declared, numbered)
             self.zsub = zenoh.ext.declare_advanced_subscriber(
                 session,
                 key,
@@ -512,7 +521,8 @@ class _Inbound:
                 recovery=zenoh.ext.RecoveryConfig(periodic_queries=None, heartbeat=True) if reliable else None,
                 subscriber_detection=True,
             )
-            self.advanced = True
+            self._history_asked.clear()
+            self.transport._ask_histories(self)
         else:
             self.zsub = session.declare_subscriber(key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
         if old is not None:
@@ -547,7 +557,7 @@ class _Inbound:
             transport._drop_sample(key, err)
             return None
         transport._received += 1
-        if self.iox is not None:
+        if self.iox is not None or self.advanced:
             return gid, msg, _SEQ.unpack_from(att)[0]
         return gid, msg
 
@@ -555,7 +565,7 @@ class _Inbound:
     def _inject(self, gid: bytes, msg: Any, seq: int | None = None, iceoryx2: bool = False) -> None:
         """On the main loop: publish a received message into the bus as its remote publisher
         (``seq``: its sequence number, when it may arrive over iceoryx2 and zenoh both)."""
-        if seq is not None and self._delivered.seen(gid, seq, iceoryx2):
+        if seq is not None and self._delivered.seen(gid, seq, iceoryx2 or self.advanced):
             return
         injector = self._injector
         if gid != self._gid or injector is None or injector.destroyed:
@@ -574,6 +584,20 @@ class _Inbound:
             self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
         finally:
             local.injecting = False
+
+    def _late_history(self, replies: list[tuple[bytes, Any, int]]) -> None:
+        """On the loop: the history a remote session's publisher caches answered with (transient
+        local), delivered unless delivered already. One older than the ``depth`` newest of its
+        publisher delivered so far is left out: a subscription that keeps the last ``depth``
+        messages would not hold it (a depth-1 latched topic never goes back to an older message)."""
+        if self.zsub is None:
+            return
+        delivered = self._delivered
+        for gid, msg, seq in sorted(replies, key=lambda r: (r[0], r[2])):
+            newest = delivered.newest(gid)
+            if newest is not None and newest - seq >= self.depth:
+                continue
+            self._inject(gid, msg, seq)
 
     def close(self) -> None:
         if self._iox_token is not None:
@@ -1053,6 +1077,58 @@ class ZenohTransport(Transport):
         if out is not None and out.iox is not None:
             out.iox.own = 1
 
+    def _ask_histories(self, inb: _Inbound) -> None:
+        """Ask every remote session with a transient-local publisher of ``inb``'s topic for its
+        history (zenoh-ext's own query may have gone out before routes to them existed)."""
+        for token, entry in list(self._remote.items()):
+            if (
+                isinstance(entry, _Injector) and entry.topic_name == inb.topic and entry.msg_type is inb.msg_type
+                and entry.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL
+            ):
+                self._ask_history(inb, parse_token(token).zid)
+
+    def _ask_history(self, inb: _Inbound, zid: str) -> None:
+        """Query the caches of session ``zid``'s publishers of ``inb``'s topic; what they answer is
+        delivered by :meth:`_Inbound._late_history` unless delivered already.
+
+        zenoh-ext's advanced subscriber queries every cache when it is declared, and the cache of a
+        publisher it discovers later. A session that has just opened may send its first query
+        before it knows a route to the publishers (no reply), and a live message delivered before
+        the later query's replies makes zenoh-ext drop every older one (its sequenced samples are
+        not held while that query is pending): a late joiner then lost the history of a topic whose
+        publisher kept publishing (1 trial in 6-8 in a probe). So the transport asks each
+        session once itself when it learns of its publisher, and the inbound keeps what it delivered."""
+        import zenoh
+
+        if zid in inb._history_asked or inb.zsub is None:
+            return
+        inb._history_asked.add(zid)
+        replies: list[tuple[bytes, Any, int]] = []
+
+        def on_reply(reply: Any) -> None:
+            sample = reply.ok
+            if sample is not None:
+                decoded = inb._decode(sample)
+                if decoded is not None and len(decoded) == 3:
+                    replies.append(decoded)  # type: ignore[arg-type]
+
+        def on_done() -> None:
+            loop = inb.inbox.loop if inb.inbox is not None else self._loop
+            if replies and loop is not None:
+                post(loop, inb._late_history, replies)
+
+        try:
+            self._session.get(  # (zenoh-ext 1.10's caches: <key>/@adv/pub/<zid>/<eid>/<meta>; replies on <key>)
+                f"{inb.key}/@adv/*/{zid}/**?_max={inb.depth}",
+                zenoh.handlers.Callback(on_reply, on_done),
+                target=zenoh.QueryTarget.ALL,
+                consolidation=zenoh.ConsolidationMode.NONE,
+                accept_replies=zenoh.ReplyKeyExpr.ANY,
+                timeout=DESCRIBE_TIMEOUT_SEC,
+            )
+        except Exception as err:  # noqa: BLE001 - the session is closing: nothing to deliver
+            _log.debug(f"history of {inb.topic} from {zid} not asked: {err}")
+
     def _iox_refused(self, topic: str, what: str, err: Exception) -> None:
         _log.warning(
             f"iceoryx2_topics: cannot {what} {topic} over iceoryx2 ({type(err).__name__}: {err}); "
@@ -1415,6 +1491,9 @@ class ZenohTransport(Transport):
             self._remote[info.token] = injector
             self._by_gid[gid_of(info.token)] = injector
             self._add_to_bus(injector)
+            inb = self._inbound.get((info.topic, info.type_name))
+            if inb is not None and inb.advanced and info.qos.durability is DurabilityPolicy.TRANSIENT_LOCAL:
+                self._ask_history(inb, info.zid)
         elif info.kind == "MS":
             tap = Tap(cls, info.topic, info.qos, _ignore, owner=info.node_fqn, keeps=False)
             self._remote[info.token] = tap
