@@ -482,6 +482,7 @@ class _Inbound:
         self._iox_token: Any = None
         self._delivered = Delivered()
         self._history_asked: set[str] = set()  # sessions whose publishers' caches this inbound queried
+        self._queriers: dict[str, tuple[Any, Any]] = {}  # session -> (querier, matching listener) still asking
 
     def add(self, sub: Any) -> None:
         self.subscriptions.append(sub)
@@ -522,7 +523,7 @@ class _Inbound:
                 subscriber_detection=True,
             )
             self._history_asked.clear()
-            self.transport._ask_histories(self)
+            self.transport._ask_histories(self)  # (old queriers stay: their answers still count)
         else:
             self.zsub = session.declare_subscriber(key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
         if old is not None:
@@ -565,8 +566,13 @@ class _Inbound:
     def _inject(self, gid: bytes, msg: Any, seq: int | None = None, iceoryx2: bool = False) -> None:
         """On the main loop: publish a received message into the bus as its remote publisher
         (``seq``: its sequence number, when it may arrive over iceoryx2 and zenoh both)."""
-        if seq is not None and self._delivered.seen(gid, seq, iceoryx2 or self.advanced):
-            return
+        if seq is not None:
+            if self.advanced:  # a transient-local topic keeps its last ``depth``: never one older
+                newest = self._delivered.newest(gid)
+                if newest is not None and newest - seq >= self.depth:
+                    return
+            if self._delivered.seen(gid, seq, iceoryx2 or self.advanced):
+                return
         injector = self._injector
         if gid != self._gid or injector is None or injector.destroyed:
             injector = self.transport._by_gid.get(gid)
@@ -585,6 +591,14 @@ class _Inbound:
         finally:
             local.injecting = False
 
+    def _history_answered(self, zid: str, replies: list[tuple[bytes, Any, int]]) -> None:
+        """On the loop: session ``zid``'s caches answered; done with its querier."""
+        querier = self._queriers.pop(zid, None)
+        if querier is not None:
+            for entity in reversed(querier):
+                entity.undeclare()
+        self._late_history(replies)
+
     def _late_history(self, replies: list[tuple[bytes, Any, int]]) -> None:
         """On the loop: the history a remote session's publisher caches answered with (transient
         local), delivered unless delivered already. One older than the ``depth`` newest of its
@@ -592,14 +606,14 @@ class _Inbound:
         messages would not hold it (a depth-1 latched topic never goes back to an older message)."""
         if self.zsub is None:
             return
-        delivered = self._delivered
         for gid, msg, seq in sorted(replies, key=lambda r: (r[0], r[2])):
-            newest = delivered.newest(gid)
-            if newest is not None and newest - seq >= self.depth:
-                continue
             self._inject(gid, msg, seq)
 
     def close(self) -> None:
+        for querier in self._queriers.values():
+            for entity in reversed(querier):
+                entity.undeclare()
+        self._queriers.clear()
         if self._iox_token is not None:
             self._iox_token.undeclare()
             self._iox_token = None
@@ -1088,22 +1102,24 @@ class ZenohTransport(Transport):
                 self._ask_history(inb, parse_token(token).zid)
 
     def _ask_history(self, inb: _Inbound, zid: str) -> None:
-        """Query the caches of session ``zid``'s publishers of ``inb``'s topic; what they answer is
-        delivered by :meth:`_Inbound._late_history` unless delivered already.
+        """Query the caches of session ``zid``'s publishers of ``inb``'s topic as soon as a route
+        to them exists (a querier's matching status); what they answer is delivered by
+        :meth:`_Inbound._late_history` unless delivered already.
 
         zenoh-ext's advanced subscriber queries every cache when it is declared, and the cache of a
         publisher it discovers later. A session that has just opened may send its first query
         before it knows a route to the publishers (no reply), and a live message delivered before
         the later query's replies makes zenoh-ext drop every older one (its sequenced samples are
         not held while that query is pending): a late joiner then lost the history of a topic whose
-        publisher kept publishing (1 trial in 6-8 in a probe). So the transport asks each
-        session once itself when it learns of its publisher, and the inbound keeps what it delivered."""
+        publisher kept publishing (1 trial in 6-8 in a probe). So the transport asks each session
+        once itself, and the inbound delivers each (publisher, sequence number) once."""
         import zenoh
 
         if zid in inb._history_asked or inb.zsub is None:
             return
         inb._history_asked.add(zid)
         replies: list[tuple[bytes, Any, int]] = []
+        asked = threading.Event()
 
         def on_reply(reply: Any) -> None:
             sample = reply.ok
@@ -1114,18 +1130,28 @@ class ZenohTransport(Transport):
 
         def on_done() -> None:
             loop = inb.inbox.loop if inb.inbox is not None else self._loop
-            if replies and loop is not None:
-                post(loop, inb._late_history, replies)
+            if loop is not None:
+                post(loop, inb._history_answered, zid, replies)
+
+        def ask() -> None:
+            if asked.is_set():
+                return
+            asked.set()
+            querier.get(zenoh.handlers.Callback(on_reply, on_done), parameters=f"_max={inb.depth}")
 
         try:
-            self._session.get(  # (zenoh-ext 1.10's caches: <key>/@adv/pub/<zid>/<eid>/<meta>; replies on <key>)
-                f"{inb.key}/@adv/*/{zid}/**?_max={inb.depth}",
-                zenoh.handlers.Callback(on_reply, on_done),
+            # (zenoh-ext 1.10's caches: <key>/@adv/pub/<zid>/<eid>/<meta>, replying on <key>)
+            querier = self._session.declare_querier(
+                f"{inb.key}/@adv/*/{zid}/**",
                 target=zenoh.QueryTarget.ALL,
                 consolidation=zenoh.ConsolidationMode.NONE,
                 accept_replies=zenoh.ReplyKeyExpr.ANY,
                 timeout=DESCRIBE_TIMEOUT_SEC,
             )
+            listener = querier.declare_matching_listener(lambda status: status.matching and ask())
+            inb._queriers[zid] = (querier, listener)
+            if querier.matching_status:
+                ask()
         except Exception as err:  # noqa: BLE001 - the session is closing: nothing to deliver
             _log.debug(f"history of {inb.topic} from {zid} not asked: {err}")
 
