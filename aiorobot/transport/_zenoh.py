@@ -299,6 +299,7 @@ class _Outbound:
         self.iox: Any = None  # the iceoryx2 sender (iceoryx2_topics)
         # a remote subscription of the topic is not served over iceoryx2: large messages go over zenoh too
         self.zenoh_needed = True
+        self.said = False  # which way large messages go was logged
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>", keeps=False)
         self.tap.hidden = True  # type: ignore[attr-defined]
 
@@ -1204,7 +1205,18 @@ class ZenohTransport(Transport):
                 continue
             inputs = self._iox_inputs.get(key, {})
             service = self._iceoryx2_service(topic, type_hash)
-            out.zenoh_needed = not all(z in inputs and self._iox.attached(service, inputs[z]) for z in zids)
+            served = [z for z in zids if z in inputs and self._iox.attached(service, inputs[z])]
+            needed = len(served) < len(zids)
+            if needed != out.zenoh_needed or not out.said:  # say which way large messages go, when it changes
+                out.said = True
+                if needed:
+                    _log.info(
+                        f"iceoryx2_topics: large messages on {topic} go over zenoh too: {len(zids) - len(served)} of "
+                        f"{len(zids)} subscribing processes are not on this host's iceoryx2 path"
+                    )
+                else:
+                    _log.info(f"iceoryx2_topics: large messages on {topic} go over iceoryx2 alone ({len(zids)} subscribing processes)")
+            out.zenoh_needed = needed
 
     def _hash(self, msg_type: Any) -> str:
         cached = self._hashes.get(msg_type)

@@ -249,7 +249,8 @@ async def test_a_publisher_killed_with_sigkill_leaves_the_receiver_running_and_a
         assert rt.transport.statistics().dropped == 0 and inbound.iox._thread.is_alive()
 
 
-async def test_a_subscriber_killed_with_sigkill_is_released_and_the_publisher_goes_on(router_port: int) -> None:
+async def test_a_subscriber_killed_with_sigkill_is_released_and_the_publisher_goes_on(router_port: int, caplog: Any) -> None:
+    caplog.set_level("INFO", logger="aiorobot.transport")
     async with _viewer(router_port) as rt:
         pub = rt.add_node(Node("camera")).create_publisher(Image, _topic(router_port), 10)
         out = rt.transport._outbound[(_topic(router_port), "sensor_msgs/msg/Image")]
@@ -276,6 +277,10 @@ async def test_a_subscriber_killed_with_sigkill_is_released_and_the_publisher_go
             await again.stop()
         stats = rt.transport.statistics()
         assert stats.sent_iceoryx2 == 6 and stats.dropped == 0
+        said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("iceoryx2_topics: large messages")]
+        alone = f"iceoryx2_topics: large messages on {_topic(router_port)} go over iceoryx2 alone (1 subscribing processes)"
+        assert said[0] == alone and said[-1] == alone, said  # the first sink, then the second one
+        assert len(said) in (2, 3), said  # (between them, "over zenoh too" if the dead process's tokens went apart)
 
 
 async def test_one_process_publishing_and_subscribing_sends_nothing_to_itself(router_port: int) -> None:
