@@ -592,10 +592,10 @@ class _Inbound:
         finally:
             local.injecting = False
 
-    def _history_answered(self, zid: str, replies: list[tuple[bytes, Any, int]]) -> None:
-        """On the loop: session ``zid``'s caches answered; done with its querier."""
-        querier = self._queriers.pop(zid, None)
-        if querier is not None:
+    def _history_answered(self, zid: str, querier: Any, replies: list[tuple[bytes, Any, int]]) -> None:
+        """On the loop: session ``zid``'s caches answered ``querier``'s query; done with it."""
+        if querier is not None and self._queriers.get(zid) is querier:
+            del self._queriers[zid]
             for entity in reversed(querier):
                 entity.undeclare()
         self._late_history(replies)
@@ -1121,6 +1121,7 @@ class ZenohTransport(Transport):
         inb._history_asked.add(zid)
         replies: list[tuple[bytes, Any, int]] = []
         asked = threading.Event()
+        entry: Any = None  # (querier, matching listener), once declared
 
         def on_reply(reply: Any) -> None:
             sample = reply.ok
@@ -1132,7 +1133,7 @@ class ZenohTransport(Transport):
         def on_done() -> None:
             loop = inb.inbox.loop if inb.inbox is not None else self._loop
             if loop is not None:
-                post(loop, inb._history_answered, zid, replies)
+                post(loop, inb._history_answered, zid, entry, replies)
 
         def ask() -> None:
             if asked.is_set():
@@ -1150,7 +1151,10 @@ class ZenohTransport(Transport):
                 timeout=DESCRIBE_TIMEOUT_SEC,
             )
             listener = querier.declare_matching_listener(lambda status: status.matching and ask())
-            inb._queriers[zid] = (querier, listener)
+            old = inb._queriers.pop(zid, None)  # (asked again after a redeclaration: the new one answers)
+            for entity in reversed(old or ()):
+                entity.undeclare()
+            entry = inb._queriers[zid] = (querier, listener)
             if querier.matching_status:
                 ask()
         except Exception as err:  # noqa: BLE001 - the session is closing: nothing to deliver

@@ -273,14 +273,15 @@ async def test_a_subscriber_killed_with_sigkill_is_released_and_the_publisher_go
                 pub.publish(_frame(i))
             again.send("3")
             assert (await again.expect("got")).split()[1:] == ["20,21,22", "3"]
+            said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("iceoryx2_topics: large messages")]
         finally:
             await again.stop()
         stats = rt.transport.statistics()
         assert stats.sent_iceoryx2 == 6 and stats.dropped == 0
-        said = [r.getMessage() for r in caplog.records if r.getMessage().startswith("iceoryx2_topics: large messages")]
         alone = f"iceoryx2_topics: large messages on {_topic(router_port)} go over iceoryx2 alone (1 subscribing processes)"
-        assert said[0] == alone and said[-1] == alone, said  # the first sink, then the second one
-        assert len(said) in (2, 3), said  # (between them, "over zenoh too" if the dead process's tokens went apart)
+        # the first sink, then the second one; "over zenoh too" between, as a sink's subscription is
+        # known before its iceoryx2 input, or the dead one's input went before its subscription
+        assert said[-1] == alone and said.count(alone) == 2, said
 
 
 async def test_one_process_publishing_and_subscribing_sends_nothing_to_itself(router_port: int) -> None:

@@ -60,7 +60,7 @@ async def test_a_late_joiner_made_as_its_session_opens_gets_the_history_once_whi
     router_port: int,
 ) -> None:
     def check(trial: int, got: list[str]) -> None:
-        history = [g for g in got if g.startswith("history")]
+        history = sorted(g for g in got if g.startswith("history"))  # (what the transport fetched may come last)
         assert history == [f"history {i}" for i in range(5)], f"trial {trial}: {got[:8]}"
         assert len(got) == len(set(got)), f"trial {trial}: delivered twice: {sorted(g for g in got if got.count(g) > 1)[:6]}"
 
