@@ -413,25 +413,27 @@ class _Outbound:
 
 
 class Delivered:
-    """Which messages of each publisher were delivered, by sequence number: a topic received over
-    iceoryx2 and zenoh both delivers each message once (the copy that comes second is dropped).
+    """Which messages of each publisher were delivered, by sequence number: a topic received two
+    ways (over iceoryx2 and zenoh; a transient-local topic's history from zenoh-ext and from the
+    transport's own query) delivers each message once, the copy that comes second dropped.
+
     The ``window`` newest numbers of each publisher are remembered (``WINDOW`` at least; a
-    transient-local topic's depth); an older one counts as delivered. Only a publisher that has sent over iceoryx2 has its zenoh messages dropped as
-    copies: one that sends over zenoh alone (an rmw_zenoh node, another host) is never second-guessed
-    on its sequence numbers."""
+    transient-local topic's depth); an older one counts as delivered. A copy is dropped only for a
+    publisher marked as reaching this inbound two ways (``seen(..., twice=True)``): one that sends
+    over zenoh alone (an rmw_zenoh node, another host) is never second-guessed on its numbers."""
 
     def __init__(self, window: int = 0) -> None:
-        self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits, over iceoryx2]
+        self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits, may come twice]
         self.window = max(window, WINDOW)
 
-    def seen(self, gid: bytes, seq: int, iceoryx2: bool = False) -> bool:
-        """Whether ``seq`` of ``gid`` (which came over iceoryx2, or zenoh) was delivered already;
-        if not, it is from now on."""
+    def seen(self, gid: bytes, seq: int, twice: bool = False) -> bool:
+        """Whether ``seq`` of ``gid`` was delivered already; if not, it is from now on. ``twice``:
+        this copy came a way that makes ``gid`` a publisher whose messages may come twice."""
         entry = self._by_gid.get(gid)
         if entry is None:
-            self._by_gid[gid] = [seq, 1, iceoryx2]
+            self._by_gid[gid] = [seq, 1, twice]
             return False
-        if iceoryx2:
+        if twice:
             entry[2] = True
         newest, bits, both = entry
         window = self.window
@@ -524,7 +526,7 @@ class _Inbound:
                 subscriber_detection=True,
             )
             self._history_asked.clear()
-            self.transport._ask_histories(self)  # (old queriers stay: their answers still count)
+            self.transport._ask_histories(self)  # (a session asked before: its new querier replaces the old)
         else:
             self.zsub = session.declare_subscriber(key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
         if old is not None:
@@ -565,8 +567,9 @@ class _Inbound:
 
 
     def _inject(self, gid: bytes, msg: Any, seq: int | None = None, iceoryx2: bool = False) -> None:
-        """On the main loop: publish a received message into the bus as its remote publisher
-        (``seq``: its sequence number, when it may arrive over iceoryx2 and zenoh both)."""
+        """On the inbox's loop: publish a received message into the bus as its remote publisher.
+        ``seq``: its sequence number, when it may arrive two ways (over iceoryx2 and zenoh; on a
+        transient-local topic, as history from zenoh-ext and from the transport's own query)."""
         if seq is not None:
             if self.advanced:  # a transient-local topic keeps its last ``depth``: never one older
                 newest = self._delivered.newest(gid)
