@@ -598,9 +598,7 @@ class _Inbound:
     def _history_answered(self, zid: str, querier: Any, replies: list[tuple[bytes, Any, int]]) -> None:
         """On the loop: session ``zid``'s caches answered ``querier``'s query; done with it."""
         if querier is not None and self._queriers.get(zid) is querier:
-            del self._queriers[zid]
-            for entity in reversed(querier):
-                entity.undeclare()
+            _undeclare(self._queriers.pop(zid))
         self._late_history(replies)
 
     def _late_history(self, replies: list[tuple[bytes, Any, int]]) -> None:
@@ -615,8 +613,7 @@ class _Inbound:
 
     def close(self) -> None:
         for querier in self._queriers.values():
-            for entity in reversed(querier):
-                entity.undeclare()
+            _undeclare(querier)
         self._queriers.clear()
         if self._iox_token is not None:
             self._iox_token.undeclare()
@@ -1154,9 +1151,7 @@ class ZenohTransport(Transport):
                 timeout=DESCRIBE_TIMEOUT_SEC,
             )
             listener = querier.declare_matching_listener(lambda status: status.matching and ask())
-            old = inb._queriers.pop(zid, None)  # (asked again after a redeclaration: the new one answers)
-            for entity in reversed(old or ()):
-                entity.undeclare()
+            _undeclare(inb._queriers.pop(zid, ()))  # (asked again after a redeclaration: the new one answers)
             entry = inb._queriers[zid] = (querier, listener)
             if querier.matching_status:
                 ask()
@@ -1779,6 +1774,12 @@ def _refusal(plan: SessionPlan, err: BaseException) -> str:
         return f"zenoh could not open the session ({plan.mode} mode, {plan.source}): {text}"
     reasons = "; ".join(f"{ep}: {why_unreachable(ep, plan.tls)}" for ep in plan.connect)
     return f"zenoh session refused ({plan.mode} mode, {plan.source}): {reasons}"
+
+
+def _undeclare(querier: tuple[Any, ...]) -> None:
+    """Undeclare a history querier and its matching listener, the listener first."""
+    for entity in reversed(querier):
+        entity.undeclare()
 
 
 def _ignore(_msg: Any) -> None:
