@@ -189,12 +189,9 @@ class Publisher(Endpoint, Generic[M]):
         """Publish through :meth:`_publish_watched` when a QoS watcher, a lifespan or a subscriber
         that takes MessageInfo needs it; otherwise through the plain :meth:`publish`."""
         self._info = self._lifespan_ns is not None or subscriber_wants_info
-        watched = self._info or self._deadline is not None or self._liveliness is not None
-        if watched and not self._watched:
-            self.publish = self._publish_watched  # type: ignore[method-assign]
-        elif self._watched and not watched:
-            del self.publish  # (never through __dict__: that would slow every attribute of this object)
-        self._watched = watched
+        # (a flag :meth:`publish` tests, not a method bound over it: ``pub.publish`` handed out as a
+        # callback before a subscriber that takes MessageInfo matched must still serve it)
+        self._watched = self._info or self._deadline is not None or self._liveliness is not None
 
     def _set_targets(self, subs: tuple[Subscription | Tap, ...], *, leaving: Endpoint | None = None) -> None:
         """Install the matched subscriptions (called by the bus under its lock); ``leaving``: the
@@ -259,6 +256,9 @@ class Publisher(Endpoint, Generic[M]):
         rclpy difference: subscribers of one publish share one copy, whose arrays and
         sequences are read-only (docs/rclpy-differences.md).
         """
+        if self._watched:
+            self._publish_watched(msg)
+            return
         msg = self._accept(msg)
         if self._history is not None:
             self._history.append((msg, None))

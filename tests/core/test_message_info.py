@@ -27,6 +27,23 @@ async def test_two_argument_callback_gets_message_info(runtime):
         assert 0 < info["source_timestamp"] <= info["received_timestamp"]
 
 
+async def test_a_publish_method_kept_before_the_info_subscription_came_still_gives_it_info(runtime):
+    # a relay passes pub.publish as a callback before its subscribers exist: the method it kept
+    # must serve whoever matches later (here a callback that takes MessageInfo)
+    node = runtime.add_node(Node("relay"))
+    pub = node.create_publisher(Int32, "/out", 10)
+    node.create_subscription(Int32, "/in", pub.publish, 10)
+    relayed, seen = [], []
+    node.create_subscription(Int32, "/out", lambda msg, info: relayed.append(info), 10)
+    node.create_subscription(Int32, "/out", seen.append, 10)
+    source = node.create_publisher(Int32, "/in", 10)
+    for k in range(2):
+        source.publish(Int32(data=k))
+    await settle(runtime)
+    assert [m.data for m in seen] == [0, 1]
+    assert [info["publication_sequence_number"] for info in relayed] == [1, 2]
+
+
 async def test_message_info_on_another_loop_and_from_a_late_joiner_history(runtime):
     node = runtime.add_node(Node("pub"))
     qos = QoSProfile(depth=5, durability=DurabilityPolicy.TRANSIENT_LOCAL)
