@@ -262,7 +262,11 @@ class Publisher(Endpoint, Generic[M]):
         msg = self._accept(msg)
         if self._history is not None:
             self._history.append((msg, None))
-        self._fan_out(msg)
+        if self._same_loop or self._other_loops:
+            self._fan_out(msg)
+        else:  # no subscription of this process: only taps take it (a transport sending it on)
+            for tap in self._taps:
+                tap._enqueue(msg)
 
     def _publish_watched(self, msg: M) -> None:
         """:meth:`publish` for a publisher with a finite deadline, lease or lifespan, or with a
