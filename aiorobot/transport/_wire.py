@@ -9,6 +9,7 @@ other's data and graph.
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -242,9 +243,10 @@ def attachment_tail(gid: bytes) -> bytes:
     return bytes((_GID_SIZE,)) + gid
 
 
-def attachment_head(sequence: int, timestamp_ns: int) -> bytes:
-    """The per-message part of an attachment: sequence number and timestamp (16 bytes)."""
-    return _HEAD.pack(sequence, timestamp_ns)
+#: ``attachment_head(sequence, timestamp_ns)``: the per-message part of an attachment, sequence
+#: number and timestamp (16 bytes). The struct's own ``pack``: every put calls it, with no Python
+#: frame of its own.
+attachment_head: Callable[[int, int], bytes] = _HEAD.pack
 
 
 def pack_attachment(sequence: int, timestamp_ns: int, gid: bytes) -> bytes:
