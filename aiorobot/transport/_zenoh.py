@@ -465,12 +465,15 @@ class _Inbound:
     """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
+        import zenoh
+
         self.transport = transport
         self.topic = topic
         self.msg_type = msg_type
         self.type_hash = type_hash
         self.prefix = f"{transport.domain_id}/{topic.strip('/')}/{dds_type(msg_type.__msgtype__)}"
         self.key = f"{self.prefix}/{type_hash}"
+        self.key_expr = zenoh.KeyExpr(self.key)
         self.subscriptions: list[Subscription[Any]] = []
         self.zsub: Any = None
         self.advanced = False
@@ -533,16 +536,24 @@ class _Inbound:
             old.undeclare()
 
     def _on_sample(self, sample: Any) -> None:
-        """On a zenoh thread: decode the sample and queue it for the main loop."""
-        self.transport._queue(self, sample)
+        """On a zenoh thread: check and decode the sample, queue it in the inbox of the loop the
+        topic's subscriptions run on, and wake that loop unless a drain is due already (one
+        ``call_soon_threadsafe`` per batch of samples that arrive together).
+
+        The loop is woken after the decoding, not before it: woken first, it competed with this
+        thread for the GIL during the decoding; the wake-up then cost a Twist 12-17 us and an image
+        ~50 us on this 2-CPU VM, against 2-7 us after it (docs/zenoh.md)."""
+        decoded = self._decode(sample)
+        if decoded is not None:
+            (self.inbox or self.transport._inbox).put(self, decoded)
 
     def _decode(self, sample: Any) -> tuple[bytes, Any] | None:
         """Check a sample (key, attachment, CDR) and decode it: ``(gid, message)``, or None when dropped."""
         transport = self.transport
-        key = str(sample.key_expr)
+        key_expr = sample.key_expr
         try:
-            if key != self.key:
-                found_hash = key[len(self.prefix) + 1 :]
+            if key_expr != self.key_expr:  # (compared as zenoh key expressions: no string made)
+                found_hash = str(key_expr)[len(self.prefix) + 1 :]
                 raise WireError(
                     f"type hash on {self.topic}: expected {self.type_hash} for {self.msg_type.__msgtype__}, "
                     f"found {found_hash or 'none'}; the two sides use different definitions"
@@ -558,7 +569,7 @@ class _Inbound:
             if len(data) >= SHM_MIN_CHECK and payload.as_shm() is not None:
                 transport._received_shm += 1
         except Exception as err:  # noqa: BLE001 - nothing from the network may escape
-            transport._drop_sample(key, err)
+            transport._drop_sample(str(key_expr), err)
             return None
         transport._received += 1
         if self.iox is not None or self.advanced:
@@ -1038,7 +1049,7 @@ class ZenohTransport(Transport):
         if self._loop is not None:
             post(self._loop, fn, *args)
 
-    def _queue(self, inbound: _Inbound, sample: Any) -> None:
+    def _on_sample(self, sample: Any) -> None:
         """On a zenoh thread: check and decode the sample, queue it in the inbox of the loop the
         topic's subscriptions run on, and wake that loop unless a drain is due already (one
         ``call_soon_threadsafe`` per batch of samples that arrive together).
@@ -1046,10 +1057,9 @@ class ZenohTransport(Transport):
         The loop is woken after the decoding, not before it: woken first, it competed with this
         thread for the GIL during the decoding; the wake-up then cost a Twist 12-17 us and an image
         ~50 us on this 2-CPU VM, against 2-7 us after it (docs/zenoh.md)."""
-        decoded = inbound._decode(sample)
+        decoded = self._decode(sample)
         if decoded is not None:
-            (inbound.inbox or self._inbox).put(inbound, decoded)
-
+            (self.inbox or self.transport._inbox).put(self, decoded)
     def _inbox_for(self, loop: asyncio.AbstractEventLoop | None) -> _Inbox | None:
         """The inbox of ``loop`` (None: the main loop's)."""
         if loop is None or loop is self._loop:
