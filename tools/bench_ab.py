@@ -19,14 +19,21 @@ import subprocess
 import sys
 from pathlib import Path
 
-_CODE = "from aiorobot.bench import _zenoh; import json; print('RESULT ' + json.dumps(_zenoh.run(quick={quick})))"
+_CODE = """
+import json
+from aiorobot.bench import _zenoh
+keep, found = {paths!r}, _zenoh.available_paths
+if keep:  # the other paths are left out, as if not installed
+    _zenoh.available_paths = lambda: {{p: why if p in keep else "left out" for p, why in found().items()}}
+print("RESULT " + json.dumps(_zenoh.run(quick={quick})))
+"""
 
 
-def _one(tree: Path, quick: bool) -> dict[str, float]:
+def _one(tree: Path, quick: bool, paths: list[str]) -> dict[str, float]:
     env = dict(os.environ, PYTHONPATH=str(tree))
     out = subprocess.run(
-        [sys.executable, "-c", _CODE.format(quick=quick)], env=env, capture_output=True, text=True, cwd="/tmp",
-        check=False,
+        [sys.executable, "-c", _CODE.format(quick=quick, paths=paths)], env=env, capture_output=True, text=True,
+        cwd="/tmp", check=False,
     )
     lines = [line for line in out.stdout.splitlines() if line.startswith("RESULT ")]
     if not lines:
@@ -53,7 +60,11 @@ def main() -> None:
     parser.add_argument("b", type=Path, help="the other source tree")
     parser.add_argument("--runs", type=int, default=3, help="runs of each tree (default 3)")
     parser.add_argument("--quick", action="store_true", help="the bench's quick traffic (noisier)")
+    parser.add_argument(
+        "--paths", default="", help="only these paths, comma-separated (aiorobot and zenoh always; default: all installed)"
+    )
     args = parser.parse_args()
+    paths = sorted({"aiorobot", "zenoh", *filter(None, args.paths.split(","))}) if args.paths else []
     trees = {"A": args.a.resolve(), "B": args.b.resolve()}
     for name, tree in trees.items():
         if not (tree / "aiorobot" / "__init__.py").is_file():
@@ -61,7 +72,7 @@ def main() -> None:
     rows: dict[str, list[dict[str, float]]] = {"A": [], "B": []}
     for i in range(args.runs):
         for name in ("A", "B") if i % 2 == 0 else ("B", "A"):
-            row = _one(trees[name], args.quick)
+            row = _one(trees[name], args.quick, paths)
             rows[name].append(row)
             print(name, " ".join(f"{k}={v:.2f}" for k, v in row.items()), flush=True)
     for name, got in rows.items():
