@@ -69,6 +69,8 @@ class Context:
         self._saved_unraisablehook: Any = None
         #: Ctrl-C arrived while the loop ran in this thread: the spin raises KeyboardInterrupt on its way out
         self._interrupted = False
+        #: ``sys.exit()`` in a callback: the spin in progress raises it on its way out
+        self._exit: SystemExit | None = None
         #: spin loops (rclpy.spin, Executor.spin) running in the main thread: Ctrl-C between two
         #: passes is raised by the loop, not wherever the main thread happens to be
         self._main_spin_depth = 0
@@ -163,6 +165,13 @@ class Context:
             self._interrupted = False
             self._close_if_idle()
             raise KeyboardInterrupt
+
+    def exit_from_callback(self, exc: SystemExit) -> None:
+        """``sys.exit()`` in a callback: the spin in progress ends and raises it, as rclpy's spin
+        does, and the entity whose callback it was lives on for a later spin (the SystemExit
+        does not end the aiorobot task that runs it)."""
+        self._exit = exc
+        self.wake()
 
     def in_callback(self) -> bool:
         return bool(getattr(self._local, "depth", 0))
@@ -287,6 +296,8 @@ class Context:
                         # it. Made after, such a wake found none and was lost: the spin slept on
                         # with its condition met (a spinner thread never saw rclpy.shutdown()).
                         waiter = self._waiter = loop.create_future()
+                        if self._exit is not None:
+                            return False
                         if done():
                             return True
                         if not self._ok:
@@ -316,6 +327,9 @@ class Context:
             self._interrupted = False
             self._close_if_idle()
             raise KeyboardInterrupt
+        if self._exit is not None:
+            exc, self._exit = self._exit, None
+            raise exc
         if not self._ok:
             self._close_if_idle()
             if raise_on_shutdown and not shut_by_callback and not result:

@@ -37,15 +37,19 @@ def wrap_callback(context: Context, fn: Callable[..., Any] | None, owner: Any = 
                 return await handler
             executor = context.executor
             pool = getattr(executor, "_pool", None)
-            if pool is not None and not is_async:
-                loop = asyncio.get_running_loop()
-                return await loop.run_in_executor(
-                    pool, functools.partial(context.call_as_callback, fn, *args, **kwargs)
-                )
-            result = context.call_as_callback(fn, *args, **kwargs)
-            if result is not None and inspect.isawaitable(result):
-                result = await result
-            return result
+            try:
+                if pool is not None and not is_async:
+                    loop = asyncio.get_running_loop()
+                    return await loop.run_in_executor(
+                        pool, functools.partial(context.call_as_callback, fn, *args, **kwargs)
+                    )
+                result = context.call_as_callback(fn, *args, **kwargs)
+                if result is not None and inspect.isawaitable(result):
+                    result = await result
+                return result
+            except SystemExit as exc:  # the spin raises it; this entity goes on
+                context.exit_from_callback(exc)
+                return None
         finally:
             context.callback_finished()
 

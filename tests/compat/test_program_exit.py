@@ -19,6 +19,8 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
+
 from ._run import FIXTURES, ROOT, WAIT_SEC, Program
 from .test_mixed_zenoh import router  # noqa: F401 - the zenoh router fixture
 
@@ -264,3 +266,43 @@ def test_a_ctrl_c_between_two_passes_of_spin_is_a_keyboard_interrupt(tmp_path: P
 
         ctx.raise_if_interrupted = then_interrupted
     """, "rclpy.spin(node)")
+
+
+# sys.exit() in a callback: rclpy's spin raises the SystemExit; the timer lives on for a later spin
+EXIT_IN_CALLBACK = textwrap.dedent("""
+    import sys
+    import rclpy
+    from rclpy.executors import MultiThreadedExecutor
+
+    rclpy.init()
+    node = rclpy.create_node('quitter')
+    ticks = []
+
+    def tick():
+        ticks.append(len(ticks) + 1)
+        print('tick', ticks[-1], flush=True)
+        if len(ticks) == 3:
+            sys.exit(3)
+
+    node.create_timer(0.01, tick)
+    try:
+        rclpy.spin(node)
+    except SystemExit as exc:
+        print('spin left with SystemExit', exc.code, flush=True)
+    while len(ticks) < 5:
+        rclpy.spin_once(node, timeout_sec=1.0)
+    print('ticks', ticks, flush=True)
+    rclpy.shutdown()
+    sys.exit(3)
+""")
+
+
+@pytest.mark.parametrize("spin", ["rclpy.spin(node)", "rclpy.spin(node, executor=MultiThreadedExecutor())"])
+def test_sys_exit_in_a_callback_leaves_spin_and_the_timer_goes_on(tmp_path: Path, spin: str):
+    script = tmp_path / "exit_in_callback.py"
+    script.write_text(EXIT_IN_CALLBACK.replace("rclpy.spin(node)", spin))
+    program = Program(str(script), exec_args=("--transport", "local"))
+    assert program.finish() == 3
+    assert "spin left with SystemExit 3" in program.output
+    assert "ticks [1, 2, 3, 4, 5]" in program.output
+    assert "Traceback" not in program.output and "never retrieved" not in program.output, program.output
