@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from ._actions import DEFAULT_RESULT_TIMEOUT_SEC, ActionClient, ActionServer
 from ._clock import Clock
 from ._groups import CallbackGroup, MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
-from ._handoff import post
+from ._handoff import post, raise_on
 from ._logging import ROSOUT_QOS, NodeLogger
 from ._names import join_fqn, resolve_name, validate_namespace, validate_node_name
 from ._node_graph import NodeGraphMixin
@@ -592,7 +592,13 @@ class Node(NodeParametersMixin, NodeGraphMixin):
 
         Unlike ``asyncio.create_task``, the node keeps the task: removing the node or shutting
         the runtime down cancels it and waits for it. ``RuntimeError`` before the node is added.
+        ``sys.exit()`` in the task ends the program as in a callback of the node (on the main
+        loop, also from the priority loop); the task then returns None.
         """
+        return self._create_task(self._exiting(coro) if self._loop is not None else coro, name=name)
+
+    def _create_task(self, coro: Awaitable[Any], *, name: str | None = None) -> asyncio.Task[Any]:
+        """:meth:`create_task` for the core's entities, whose callbacks run under :meth:`_invoke`."""
         if self._loop is None:
             if inspect.iscoroutine(coro):
                 coro.close()
@@ -602,7 +608,12 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         task.add_done_callback(self._tasks.discard)
         return task
 
-    _create_task = create_task  # the core's entities call it by this name
+    async def _exiting(self, coro: Awaitable[Any]) -> Any:
+        try:
+            return await coro
+        except SystemExit as exc:
+            self._end_program(exc)
+            return None
 
     def _start(self) -> None:
         """Start dispatchers and timers (on the node's loop), then ``on_start``."""
@@ -757,9 +768,22 @@ class Node(NodeParametersMixin, NodeGraphMixin):
                     lock.release()
         except asyncio.CancelledError:
             raise
+        except SystemExit as exc:
+            self._end_program(exc)
+            return None
         except Exception as err:
             self._report_failure(f"callback of {_describe(entity)}", err)
             return None
+
+    def _end_program(self, exc: SystemExit) -> None:
+        """``sys.exit()`` in a callback: raised on the main loop, where asyncio ends the program
+        with it as with any callback's there, also when the callback ran on the priority loop (whose
+        thread it would end silently). The entity goes on running until the runtime shuts down."""
+        runtime = self._runtime
+        loop = runtime._loop if runtime is not None else None
+        if loop is None or loop.is_closed():
+            raise exc
+        raise_on(loop, exc)
 
 
     def _invoke_now(self, entity: Any, lock: Any, fn: Callable[..., Any], arg: Any, done: Callable[[Any], Any]) -> None:
@@ -775,9 +799,12 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             if lock is not None:
                 lock.release()
             done(None)
-            if not isinstance(err, Exception):
+            if isinstance(err, SystemExit):
+                self._end_program(err)
+            elif not isinstance(err, Exception):
                 raise
-            self._report_failure(f"callback of {_describe(entity)}", err)  # logged, as _invoke does
+            else:
+                self._report_failure(f"callback of {_describe(entity)}", err)  # logged, as _invoke does
             return
         if result is not None and inspect.isawaitable(result):
             self._create_task(self._finish_now(entity, lock, result, start, done), name=f"callback of {_describe(entity)}")
@@ -793,6 +820,8 @@ class Node(NodeParametersMixin, NodeGraphMixin):
             await result
         except asyncio.CancelledError:
             raise
+        except SystemExit as exc:
+            self._end_program(exc)
         except Exception as err:  # noqa: BLE001
             self._report_failure(f"callback of {_describe(entity)}", err)
         finally:

@@ -67,6 +67,9 @@ class PriorityLoop:
         self._thread: threading.Thread | None = None
         self._ready = threading.Event()
         self._error: BaseException | None = None
+        #: takes what escapes the loop (a task that raised SystemExit or KeyboardInterrupt, which
+        #: asyncio lets out of ``run_forever``); the loop then runs on. None: the thread ends with it.
+        self.on_escape: Any = None
 
     def __repr__(self) -> str:
         state = "running" if self._thread is not None and self._thread.is_alive() else "stopped"
@@ -94,7 +97,14 @@ class PriorityLoop:
             return
         self._ready.set()
         try:
-            loop.run_forever()
+            while True:
+                try:
+                    loop.run_forever()
+                    break  # stopped
+                except BaseException as exc:
+                    if self.on_escape is None:
+                        raise
+                    self.on_escape(exc)
         finally:
             self._finish(loop)
 

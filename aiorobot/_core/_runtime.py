@@ -18,6 +18,7 @@ from ._errors import QoSIncompatibleError
 from ._clock import Clock
 from ._culprit import LateWatch
 from ._graph import EndpointInfo, Graph, NodeInfo, ServiceInfo, TopicInfo
+from ._handoff import raise_on
 from ._node import Node
 from ._priority import PriorityLoop
 from ._pubsub import Publisher, Subscription, Tap
@@ -373,6 +374,7 @@ class Runtime:
     def _priority_loop(self) -> PriorityLoop:
         if self._priority is None:
             prio = PriorityLoop(realtime=self._priority_realtime)
+            prio.on_escape = self._escaped_priority_loop
             prio.start()
             self._priority = prio
             assert prio.loop is not None and prio.thread_id is not None
@@ -385,6 +387,13 @@ class Runtime:
                     self.late_threshold, prio.thread_id, loops=loops, recent=self._recent_callback
                 )
         return self._priority
+
+    def _escaped_priority_loop(self, exc: BaseException) -> None:
+        """On the priority thread: a task there raised SystemExit or KeyboardInterrupt, which
+        asyncio lets out of the loop. Raised on the main loop instead, as if one of its tasks had
+        (the program ends as asyncio ends it); the priority loop runs on until shutdown."""
+        if self._loop is not None:
+            raise_on(self._loop, exc)
 
     @property
     def priority_loop(self) -> PriorityLoop | None:
