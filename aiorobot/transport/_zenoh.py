@@ -1049,17 +1049,6 @@ class ZenohTransport(Transport):
         if self._loop is not None:
             post(self._loop, fn, *args)
 
-    def _on_sample(self, sample: Any) -> None:
-        """On a zenoh thread: check and decode the sample, queue it in the inbox of the loop the
-        topic's subscriptions run on, and wake that loop unless a drain is due already (one
-        ``call_soon_threadsafe`` per batch of samples that arrive together).
-
-        The loop is woken after the decoding, not before it: woken first, it competed with this
-        thread for the GIL during the decoding; the wake-up then cost a Twist 12-17 us and an image
-        ~50 us on this 2-CPU VM, against 2-7 us after it (docs/zenoh.md)."""
-        decoded = self._decode(sample)
-        if decoded is not None:
-            (self.inbox or self.transport._inbox).put(self, decoded)
     def _inbox_for(self, loop: asyncio.AbstractEventLoop | None) -> _Inbox | None:
         """The inbox of ``loop`` (None: the main loop's)."""
         if loop is None or loop is self._loop:
