@@ -327,6 +327,11 @@ class ActionServer:
                 handle._status = GoalStatus.ABORTED
             self._finish(handle, action.Result())
             raise
+        except SystemExit as exc:  # the program ends, as for a callback's; the goal is aborted
+            self.node._end_program(exc)
+            if handle.is_active:
+                handle.abort()
+            result = action.Result()
         except Exception:
             log.error(f"execute of action {self.name} raised; goal {_gid_str(handle.goal_id)} aborted", exc_info=True)
             if handle.is_active:

@@ -640,7 +640,11 @@ class Node(NodeParametersMixin, NodeGraphMixin):
         """
         attempt = 0
         while True:
-            err = await self._run_hook(self.on_start, "on_start")
+            try:
+                err = await self._run_hook(self.on_start, "on_start")
+            except SystemExit as exc:  # the program ends, as for a callback's
+                self._end_program(exc)
+                return
             if err is None:
                 return
             attempt += 1

@@ -241,6 +241,10 @@ class Service(_ServiceEndpoint):
         except asyncio.CancelledError:
             _reply(call, exc=ServiceError(f"service {self.srv_name} was shut down while handling the call"))
             raise
+        except SystemExit as exc:  # the program ends, as for a callback's; the caller is told
+            _reply(call, exc=ServiceError(f"service {self.srv_name}: its handler ended the program (sys.exit)"))
+            self.node._end_program(exc)
+            return
         except Exception as err:
             self.node.get_logger().error(f"handler of service {self.srv_name} raised", exc_info=True)
             _reply(call, exc=ServiceError(f"service {self.srv_name} failed: {type(err).__name__}: {err}"))
