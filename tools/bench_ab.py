@@ -65,6 +65,11 @@ def main() -> None:
     )
     args = parser.parse_args()
     paths = sorted({"aiorobot", "zenoh", *filter(None, args.paths.split(","))}) if args.paths else []
+    from aiorobot.bench._zenoh import available_paths
+
+    unknown = sorted(set(paths) - set(available_paths()))
+    if unknown:
+        parser.error(f"--paths: expected names among {', '.join(available_paths())}; found {', '.join(unknown)}")
     trees = {"A": args.a.resolve(), "B": args.b.resolve()}
     for name, tree in trees.items():
         if not (tree / "aiorobot" / "__init__.py").is_file():
