@@ -92,6 +92,44 @@ def deliver_eagerly(publish: Callable[..., Any], *args: Any) -> None:
         sub._run_now()
 
 
+class EagerBatch:
+    """:func:`deliver_eagerly` for a run of received messages (a transport's drain), without its
+    per-message set-up: ``with EagerBatch() as batch:``, then for each message its publish and
+    ``if batch.ready: batch.run()``. Same semantics, message by message: the callbacks a
+    message woke run before the next message is published, and a message published by one of
+    them is not delivered eagerly."""
+
+    __slots__ = ("ready",)
+
+    def __init__(self) -> None:
+        self.ready: list[Subscription[Any]] = []
+
+    def __enter__(self) -> EagerBatch:
+        _EAGER.ready = self.ready
+        return self
+
+    def run(self) -> None:
+        """Run the callbacks the last message published woke, as :func:`deliver_eagerly` does."""
+        ready = self.ready
+        _EAGER.ready = None
+        done = 0
+        try:
+            for sub in ready:
+                done += 1
+                sub._run_now()
+        finally:
+            for sub in ready[done:]:  # a callback raised (KeyboardInterrupt): their dispatchers take it
+                sub._run_now(run=False)
+            ready.clear()
+            _EAGER.ready = ready
+
+    def __exit__(self, *exc: object) -> None:
+        _EAGER.ready = None
+        for sub in self.ready:  # a publish raised: their dispatchers take what was queued
+            sub._run_now(run=False)
+        self.ready.clear()
+
+
 def _type_name(msg_type: Any) -> str:
     return str(getattr(msg_type, "__msgtype__", None) or getattr(msg_type, "__name__", repr(msg_type)))
 

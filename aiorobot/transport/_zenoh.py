@@ -40,7 +40,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from .._core._handoff import post
-from .._core._pubsub import Publisher, Subscription, Tap, deliver_eagerly
+from .._core._pubsub import EagerBatch, Publisher, Subscription, Tap
 from .._core._qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from .._core._services import Client, Service, _Call, _reply
 from .._core._errors import ServiceError
@@ -597,6 +597,12 @@ class _Inbound:
                 self._gid, self._injector = gid, injector
         if injector.destroyed:
             return
+        if not injector._taps:  # nothing it could echo back: no flag to set
+            try:
+                injector.publish(msg)
+            except Exception as err:  # noqa: BLE001
+                self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
+            return
         local = self.transport._local
         local.injecting = True  # outbound taps must not echo it back
         try:
@@ -694,24 +700,27 @@ class _Inbox:
         topic (its smallest subscription depth) before the dispatchers run; then the next drain.
         One drain is due at a time; messages that pile up while the process is descheduled so never
         fill a subscription queue past its depth, and topics keep their relative order. Each
-        message is delivered eagerly (``deliver_eagerly``): an idle subscription's plain-function
+        message is delivered eagerly (``EagerBatch``): an idle subscription's plain-function
         callback runs here, not one loop iteration later in its dispatcher."""
         pending = self.pending
-        taken: dict[int, int] = {}
+        taken: dict[_Inbound, int] = {}
         try:
-            for _ in range(MAX_DRAIN):
-                try:
-                    inbound, decoded = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
-                except IndexError:
-                    break
-                n = taken.get(id(inbound), 0)
-                if n >= inbound.chunk:
-                    pending.appendleft(item)  # the topic's dispatchers run first
-                    break
-                taken[id(inbound)] = n + 1
-                if inbound.zsub is None:
-                    continue  # the topic's last subscription left meanwhile
-                deliver_eagerly(inbound._inject, *decoded)
+            with EagerBatch() as batch:
+                for _ in range(MAX_DRAIN):
+                    try:
+                        inbound, decoded = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
+                    except IndexError:
+                        break
+                    n = taken.get(inbound, 0)
+                    if n >= inbound.chunk:
+                        pending.appendleft(item)  # the topic's dispatchers run first
+                        break
+                    taken[inbound] = n + 1
+                    if inbound.zsub is None:
+                        continue  # the topic's last subscription left meanwhile
+                    inbound._inject(*decoded)
+                    if batch.ready:
+                        batch.run()
         finally:  # (also when a callback run here raises KeyboardInterrupt: the rest is not stranded)
             self._next()
 

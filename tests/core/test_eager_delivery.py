@@ -1,6 +1,7 @@
-"""Eager delivery of a received message (``deliver_eagerly``, what a transport's drain uses): an
-idle subscription's plain-function callback runs in the delivering call, not one loop iteration
-later in its dispatcher, and everything else is delivered as by any publish."""
+"""Eager delivery of a received message (``deliver_eagerly``, and ``EagerBatch``, what the zenoh
+transport's drain uses): an idle subscription's plain-function callback runs in the delivering
+call, not one loop iteration later in its dispatcher, and everything else is delivered as by any
+publish. Every test runs both ways."""
 
 from __future__ import annotations
 
@@ -8,23 +9,38 @@ import asyncio
 import logging
 
 from aiorobot import MutuallyExclusiveCallbackGroup, Node, ReentrantCallbackGroup
-from aiorobot._core._pubsub import deliver_eagerly
+import pytest
+
+from aiorobot._core._pubsub import EagerBatch, deliver_eagerly
 from aiorobot.msgs.std_msgs import Int32
 from aiorobot.testing import settle
+
+
+def _in_a_batch(publish, *args) -> None:
+    """One message delivered as a drain delivers each of its messages."""
+    with EagerBatch() as batch:
+        publish(*args)
+        if batch.ready:
+            batch.run()
+
+
+@pytest.fixture(params=[deliver_eagerly, _in_a_batch], ids=["deliver_eagerly", "EagerBatch"])
+def deliver(request):
+    return request.param
 
 
 async def _started(runtime, node: Node) -> None:
     await settle(runtime)  # dispatchers started and parked on their queues
 
 
-async def test_an_idle_plain_callback_runs_within_the_delivery(runtime) -> None:
+async def test_an_idle_plain_callback_runs_within_the_delivery(runtime, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     got: list[int] = []
     node.create_subscription(Int32, "/x", got.append, 10)
     await _started(runtime, node)
     for i in range(3):
-        deliver_eagerly(pub.publish, Int32(data=i))
+        deliver(pub.publish, Int32(data=i))
         assert [m.data for m in got] == list(range(i + 1))  # already run: no await since the delivery
     pub.publish(Int32(data=9))  # a plain publish still goes through the dispatcher
     assert len(got) == 3
@@ -34,7 +50,7 @@ async def test_an_idle_plain_callback_runs_within_the_delivery(runtime) -> None:
     assert sub.received == 4 and sub.is_idle() and node._callback_stats[sub].calls == 4  # each counted once
 
 
-async def test_coroutine_callbacks_and_busy_groups_wait_for_their_dispatcher(runtime) -> None:
+async def test_coroutine_callbacks_and_busy_groups_wait_for_their_dispatcher(runtime, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     order: list[str] = []
@@ -48,7 +64,7 @@ async def test_coroutine_callbacks_and_busy_groups_wait_for_their_dispatcher(run
     node.create_subscription(Int32, "/x", lambda m: order.append(f"plain {m.data}"), 10)
     await _started(runtime, node)
     async with busy:
-        deliver_eagerly(pub.publish, Int32(data=1))
+        deliver(pub.publish, Int32(data=1))
         assert order == ["plain 1"]
         await settle(runtime)
         assert sorted(order) == ["coro 1", "plain 1"]  # the busy group's waits for it
@@ -56,20 +72,20 @@ async def test_coroutine_callbacks_and_busy_groups_wait_for_their_dispatcher(run
     assert sorted(order) == ["busy 1", "coro 1", "plain 1"]
 
 
-async def test_a_topic_with_a_message_info_subscriber_is_delivered_through_the_dispatchers(runtime) -> None:
+async def test_a_topic_with_a_message_info_subscriber_is_delivered_through_the_dispatchers(runtime, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     got: list[tuple[str, int]] = []
     node.create_subscription(Int32, "/x", lambda m, info: got.append(("info", info["reception_sequence_number"])), 10)
     node.create_subscription(Int32, "/x", lambda m: got.append(("plain", m.data)), 10, callback_group=ReentrantCallbackGroup())
     await _started(runtime, node)
-    deliver_eagerly(pub.publish, Int32(data=5))
+    deliver(pub.publish, Int32(data=5))
     assert got == []  # MessageInfo: every subscription of the topic gets the publisher's data, queued
     await settle(runtime)
     assert sorted(got) == [("info", 1), ("plain", 5)]
 
 
-async def test_what_an_eager_callback_publishes_is_delivered_as_usual_and_in_order(runtime) -> None:
+async def test_what_an_eager_callback_publishes_is_delivered_as_usual_and_in_order(runtime, deliver) -> None:
     node = runtime.add_node(Node("relay"))
     pub = node.create_publisher(Int32, "/in", 10)
     out = node.create_publisher(Int32, "/out", 10)
@@ -83,12 +99,12 @@ async def test_what_an_eager_callback_publishes_is_delivered_as_usual_and_in_ord
     node.create_subscription(Int32, "/out", lambda m: seen.append(m.data), 10)
     await _started(runtime, node)
     for i in range(5):
-        deliver_eagerly(pub.publish, Int32(data=i))
+        deliver(pub.publish, Int32(data=i))
         await settle(runtime)
     assert seen == [0, 10, 20, 30, 40]
 
 
-async def test_a_raising_eager_callback_is_logged_and_the_subscription_goes_on(runtime, caplog) -> None:
+async def test_a_raising_eager_callback_is_logged_and_the_subscription_goes_on(runtime, caplog, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     got: list[int] = []
@@ -103,12 +119,12 @@ async def test_a_raising_eager_callback_is_logged_and_the_subscription_goes_on(r
     await _started(runtime, node)
     with caplog.at_level(logging.ERROR):
         for i in range(3):
-            deliver_eagerly(pub.publish, Int32(data=i))
+            deliver(pub.publish, Int32(data=i))
     assert got == [0, 2] and not group.locked()
     assert "callback of subscription /x of /n raised" in caplog.text and "bad one" in caplog.text
 
 
-async def test_a_plain_callback_returning_an_awaitable_holds_its_group_until_it_ends(runtime) -> None:
+async def test_a_plain_callback_returning_an_awaitable_holds_its_group_until_it_ends(runtime, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     group = MutuallyExclusiveCallbackGroup()
@@ -121,8 +137,8 @@ async def test_a_plain_callback_returning_an_awaitable_holds_its_group_until_it_
 
     node.create_subscription(Int32, "/x", lambda m: work(m), 10, callback_group=group)
     await _started(runtime, node)
-    deliver_eagerly(pub.publish, Int32(data=1))
-    deliver_eagerly(pub.publish, Int32(data=2))  # the group is held by the first: queued
+    deliver(pub.publish, Int32(data=1))
+    deliver(pub.publish, Int32(data=2))  # the group is held by the first: queued
     for _ in range(5):
         await asyncio.sleep(0)
     assert group.locked() and done == []
@@ -131,17 +147,17 @@ async def test_a_plain_callback_returning_an_awaitable_holds_its_group_until_it_
     assert done == [1, 2] and not group.locked() and node.subscriptions[0].is_idle()
 
 
-async def test_a_reentrant_group_callback_runs_eagerly_too(runtime) -> None:
+async def test_a_reentrant_group_callback_runs_eagerly_too(runtime, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     got: list[int] = []
     node.create_subscription(Int32, "/x", lambda m: got.append(m.data), 10, callback_group=ReentrantCallbackGroup())
     await _started(runtime, node)
-    deliver_eagerly(pub.publish, Int32(data=7))
+    deliver(pub.publish, Int32(data=7))
     assert got == [7]
 
 
-async def test_a_delivery_that_raises_leaves_what_it_queued_to_the_dispatchers(runtime) -> None:
+async def test_a_delivery_that_raises_leaves_what_it_queued_to_the_dispatchers(runtime, deliver) -> None:
     node = runtime.add_node(Node("n"))
     pub = node.create_publisher(Int32, "/x", 10)
     got: list[int] = []
@@ -153,9 +169,55 @@ async def test_a_delivery_that_raises_leaves_what_it_queued_to_the_dispatchers(r
         raise KeyboardInterrupt  # (a Ctrl-C landing in the delivery)
 
     try:
-        deliver_eagerly(publish_then_interrupted, Int32(data=4))
+        deliver(publish_then_interrupted, Int32(data=4))
     except KeyboardInterrupt:
         pass
     assert got == []  # not run in the interrupted delivery, but not stranded either
     await settle(runtime)
     assert got == [4]
+
+
+async def test_a_batch_runs_each_message_s_callbacks_before_publishing_the_next(runtime) -> None:
+    node = runtime.add_node(Node("n"))
+    pub = node.create_publisher(Int32, "/x", 10)
+    other = node.create_publisher(Int32, "/y", 10)
+    order: list[str] = []
+
+    def on_x(m: Int32) -> None:
+        order.append(f"x {m.data}")
+        other.publish(Int32(data=m.data))  # not delivered eagerly: the dispatcher of /y takes it
+
+    node.create_subscription(Int32, "/x", on_x, 10)
+    node.create_subscription(Int32, "/x", lambda m: order.append(f"x' {m.data}"), 10)
+    node.create_subscription(Int32, "/y", lambda m: order.append(f"y {m.data}"), 10)
+    await _started(runtime, node)
+    with EagerBatch() as batch:
+        for i in range(3):
+            pub.publish(Int32(data=i))
+            if batch.ready:
+                batch.run()
+            assert order[-2:] == [f"x {i}", f"x' {i}"]  # both ran before the next message
+    assert not any(o.startswith("y") for o in order)
+    await settle(runtime)
+    assert [o for o in order if o.startswith("y")] == ["y 0", "y 1", "y 2"]
+
+
+async def test_an_interrupted_batch_callback_leaves_the_others_to_their_dispatchers(runtime) -> None:
+    node = runtime.add_node(Node("n"))
+    pub = node.create_publisher(Int32, "/x", 10)
+    got: list[str] = []
+
+    def interrupted(m: Int32) -> None:
+        got.append("first")
+        raise KeyboardInterrupt  # (a Ctrl-C landing in the callback)
+
+    node.create_subscription(Int32, "/x", interrupted, 10)
+    node.create_subscription(Int32, "/x", lambda m: got.append("second"), 10)
+    await _started(runtime, node)
+    with pytest.raises(KeyboardInterrupt):
+        with EagerBatch() as batch:
+            pub.publish(Int32(data=1))
+            batch.run()
+    assert got == ["first"]  # the second was not run in the interrupted batch, but not stranded either
+    await settle(runtime)
+    assert got == ["first", "second"]
