@@ -474,6 +474,10 @@ class _Inbound:
         self.prefix = f"{transport.domain_id}/{topic.strip('/')}/{dds_type(msg_type.__msgtype__)}"
         self.key = f"{self.prefix}/{type_hash}"
         self.key_expr = zenoh.KeyExpr(self.key)
+        #: ``key`` declared to the session (once the first subscription declares): zenoh caches the
+        #: route of a sample whose key is a declared resource and computes it for every other one,
+        #: matching it against every declaration of the session (docs/zenoh.md)
+        self._declared: Any = None
         self.subscriptions: list[Subscription[Any]] = []
         self.zsub: Any = None
         self.advanced = False
@@ -513,6 +517,8 @@ class _Inbound:
         if self.zsub is not None and (self.advanced or not want_history) and depth <= self.depth:
             return
         old = self.zsub
+        if self._declared is None:
+            self._declared = session.declare_keyexpr(self.key)
         self.depth = max(depth, self.depth)
         self._delivered.window = max(self._delivered.window, self.depth)
         key = self.prefix + "/*"  # any hash: a mismatch is reported, not silently missed
@@ -641,6 +647,9 @@ class _Inbound:
         if self.zsub is not None:
             self.zsub.undeclare()
             self.zsub = None
+        if self._declared is not None:
+            self.transport._session.undeclare(self._declared)
+            self._declared = None
 
 
 def delivery_loop(subscriptions: list[Any], main: asyncio.AbstractEventLoop | None) -> asyncio.AbstractEventLoop | None:

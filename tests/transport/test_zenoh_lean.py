@@ -275,3 +275,24 @@ def test_delivered_passes_each_publisher_s_sequence_number_once_out_of_order_wit
     assert d.seen(c, 5, True)  # (once it sends over iceoryx2, a number delivered over zenoh is a copy)
     d.forget(a)
     assert not d.seen(a, 1)  # (a publisher gone: its numbers forgotten)
+
+
+async def test_a_subscribed_topic_s_key_is_declared_to_the_session_while_it_has_subscriptions(router_port: int) -> None:
+    """zenoh caches the route of a sample whose key is a declared resource, and computes it for every
+    other sample against every declaration of the session (half the receiving thread's time for
+    a Twist): the topic's exact key is declared while the topic has subscriptions."""
+    import zenoh
+
+    async with _beside(DRIVER, router_port, "base") as (child, rt, node):
+        got: list[int] = []
+        sub = node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), 10)
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        transport = rt.transport
+        (inbound,) = [inb for (topic, _), inb in transport._inbound.items() if topic == "/cmd_vel"]
+        assert isinstance(inbound._declared, zenoh.KeyExpr) and str(inbound._declared) == inbound.key
+        node.destroy_subscription(sub)
+        assert inbound._declared is None and not [t for (t, _) in transport._inbound if t == "/cmd_vel"]
+        again: list[int] = []
+        node.create_subscription(Twist, "/cmd_vel", lambda m: again.append(int(m.linear.x)), 10)
+        await _first_arrival(child, rt, "/cmd_vel", again)  # a new subscription: declared anew, and received
+        child.send("bye")
