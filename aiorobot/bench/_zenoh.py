@@ -490,6 +490,9 @@ def run(quick: bool = False) -> dict[str, Any]:
             continue
         got = pooled[path]
         rates = [b["received"] / max((b["last"] - b["first"]) / 1e9, 1e-9) for b in got["burst"] if b["received"] > 1]
+        cpu = [b for b in got["burst"] if b.get("cpu_sec") is not None and b["received"]]
+        received = sum(b["received"] for b in cpu)
+        cpu_us = {k: 1e6 * sum(b["cpu_sec"][k] for b in cpu) / received for k in ("zenoh", "other")} if received else None
         rows[path] = {
             "small": {**_stats(got["small"]), "sent": got["small_sent"], "send_call": _stats(got["small_cost"])},
             "image": {**_stats(got["image"]), "sent": got["image_sent"], "send_call": _stats(got["image_cost"])},
@@ -497,6 +500,9 @@ def run(quick: bool = False) -> dict[str, Any]:
                 "sent": sum(b["sent"] for b in got["burst"]),
                 "received": sum(b["received"] for b in got["burst"]),
                 "recv_msgs_per_sec": rates,
+                # the receiving process's CPU per received message during the bursts (all its
+                # threads: zenoh's runtime threads, and the rest), None where /proc cannot tell
+                "recv_cpu_us_per_msg": cpu_us,
             },
         }
     skipped = {p: why for p, why in reasons.items() if why is not None}
@@ -526,9 +532,41 @@ def _round(recv: _Peer, send: _Peer, into: dict[str, Any], n_small: int, n_image
     into["image_sent"] += sent
     into["image_cost"] += reply["cost"]
     into["image"] += _collect(recv, sent, "image")["image"]
+    before = _process_cpu(recv.proc.pid)
     sent = send.ask(f"burst {n_burst}")["sent"]
     burst = _collect(recv, sent, "burst")["burst"]
-    into["burst"].append({"sent": sent, "received": burst["n"], "first": burst["first"], "last": burst["last"]})
+    after = _process_cpu(recv.proc.pid)
+    into["burst"].append({"sent": sent, "received": burst["n"], "first": burst["first"], "last": burst["last"],
+                          "cpu_sec": None if before is None or after is None else
+                          {k: after.get(k, 0.0) - before.get(k, 0.0) for k in after}})
+
+
+#: Thread names of zenoh's Rust runtime (its network, receive, transmit, accept and application pools).
+_ZENOH_THREADS = ("rx-", "tx-", "net-", "acc-", "app-")
+
+
+def _process_cpu(pid: int) -> dict[str, float] | None:
+    """CPU seconds a process has used so far, ``{"zenoh": ..., "other": ...}``: its zenoh runtime
+    threads (by name) and the rest (Python's, pyo3's callback threads among them). None where
+    ``/proc`` cannot tell (not Linux). Threads that ended in between are not counted."""
+    import glob
+    import os
+
+    tick = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+    out = {"zenoh": 0.0, "other": 0.0}
+    tasks = glob.glob(f"/proc/{pid}/task/*")
+    if not tasks:
+        return None
+    for task in tasks:
+        try:
+            with open(f"{task}/comm") as f:
+                name = f.read().strip()
+            with open(f"{task}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:  # (the thread ended meanwhile)
+            continue
+        out["zenoh" if name.startswith(_ZENOH_THREADS) else "other"] += (int(fields[11]) + int(fields[12])) / tick
+    return out
 
 
 def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.2) -> dict[str, Any]:
@@ -571,29 +609,32 @@ def table(part: dict[str, Any]) -> Any:
     }
     for path, fig in part.get("paths", {}).items():
         if "error" in fig:
-            rows.append((names.get(path, path), fig["error"], "", "", "", "", "", ""))
+            rows.append((names.get(path, path), fig["error"], "", "", "", "", "", "", ""))
             continue
         s, i, b = fig["small"], fig["image"], fig["burst"]
         rates = b["recv_msgs_per_sec"]
         rate = f"{min(rates) / 1000:.1f}-{max(rates) / 1000:.1f}k" if rates else "-"
         if path == "aiorobot-iox":  # its small messages and bursts go over zenoh, as aiorobot's
-            rows.append((names[path], "-", "-", i.get("p50_us", nan), i.get("p99_us", nan), "-",
+            rows.append((names[path], "-", "-", i.get("p50_us", nan), i.get("p99_us", nan), "-", "-",
                          "-", i.get("send_call", {}).get("p50_us", nan)))
             continue
+        cpu = b.get("recv_cpu_us_per_msg")
+        cpu_text = f"{cpu['zenoh'] + cpu['other']:.1f} ({cpu['zenoh']:.1f} in zenoh's threads)" if cpu else "-"
         rows.append((
             names.get(path, path), s.get("p50_us", nan), s.get("p99_us", nan), i.get("p50_us", nan), i.get("p99_us", nan),
-            f"{rate} ({100 * b['received'] / max(b['sent'], 1):.0f} % of {b['sent']})",
+            f"{rate} ({100 * b['received'] / max(b['sent'], 1):.0f} % of {b['sent']})", cpu_text,
             s.get("send_call", {}).get("p50_us", nan), i.get("send_call", {}).get("p50_us", nan),
         ))
     for path, why in part.get("skipped", {}).items():
-        rows.append((path, f"not measured: {why}", "", "", "", "", "", ""))
+        rows.append((path, f"not measured: {why}", "", "", "", "", "", "", ""))
     return figure_table(
         title,
         ("path", "small p50 us", "small p99 us", "image p50 us", "image p99 us", "burst received msgs/s",
-         "send call p50 us (small)", "send call p50 us (image)"),
+         "receiver CPU us per burst msg", "send call p50 us (small)", "send call p50 us (image)"),
         rows,
         caption=f"small: {SMALL_BYTES} bytes at {SMALL_HZ:.0f} Hz; image: 640x480x3 at {IMAGE_HZ:.0f} Hz; "
-        f"pooled over {part.get('rounds', '?')} rounds; send call: publish(), put() or send alone, the message built before",
+        f"pooled over {part.get('rounds', '?')} rounds; receiver CPU: all the receiving process's threads during the bursts; "
+        "send call: publish(), put() or send alone, the message built before",
     )
 
 

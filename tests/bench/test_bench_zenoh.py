@@ -38,6 +38,27 @@ def test_each_path_carries_small_messages_images_and_a_burst(path: str, router_p
     assert all(lat > 0 for lat in got["small"] + got["image"])  # one-way, stamped by the sender
     (burst,) = got["burst"]
     assert burst["sent"] == 500 and 0 < burst["received"] <= 500 and burst["last"] >= burst["first"] > 0
+    assert set(burst["cpu_sec"]) == {"zenoh", "other"} and min(burst["cpu_sec"].values()) >= 0  # (Linux: /proc)
+
+
+def test_process_cpu_counts_what_the_process_used_and_none_for_no_process() -> None:
+    import os
+    import subprocess
+    import sys
+    import time
+
+    from aiorobot.bench._zenoh import _process_cpu
+
+    before = _process_cpu(os.getpid())
+    start = time.process_time()
+    while time.process_time() - start < 0.3:  # 0.3 s of this process's CPU, whatever the wall clock
+        pass
+    after = _process_cpu(os.getpid())
+    assert before is not None and after is not None
+    assert after["other"] - before["other"] >= 0.2  # (this thread is no zenoh thread)
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    assert _process_cpu(gone.pid) is None
 
 
 def test_a_report_taken_while_threads_record_loses_no_count() -> None:
