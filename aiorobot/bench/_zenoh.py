@@ -516,7 +516,7 @@ def _warm_up(recv: _Peer, send: _Peer) -> None:
         send.ask("small 20")
         send.ask("image 2")
         if recv.ask("report")["lat"]["small"]:
-            _collect(recv, 1 << 30, "small", quiet_sec=0.1)  # what of the warm-up is still on its way
+            _collect(recv, 1 << 30, "small", quiet_sec=0.1, first_sec=0.1)  # what of the warm-up is still on its way
             return
     raise RuntimeError(f"nothing reached the {recv.path} receiver in 20 s")
 
@@ -569,11 +569,13 @@ def _process_cpu(pid: int) -> dict[str, float] | None:
     return out
 
 
-def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.2) -> dict[str, Any]:
+def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.2, first_sec: float = 5.0) -> dict[str, Any]:
     """The receiver's reports merged until ``expected`` messages of ``kind`` arrived or none came for
-    ``quiet_sec`` (what did not arrive by then was lost)."""
+    ``quiet_sec`` after the first (what did not arrive by then was lost), or none came at all for
+    ``first_sec`` (a loaded machine may take longer than ``quiet_sec`` to deliver the first)."""
     got: dict[str, Any] = {"small": [], "image": [], "burst": {"n": 0, "first": 0, "last": 0}}
     last_change = time.monotonic()
+    arrived = False
     while True:
         report = recv.ask("report")
         got["small"] += report["lat"]["small"]
@@ -586,7 +588,8 @@ def _collect(recv: _Peer, expected: int, kind: str, quiet_sec: float = 0.2) -> d
         n = into["n"] if kind == "burst" else len(got[kind])
         if report["lat"]["small"] or report["lat"]["image"] or b["n"]:
             last_change = time.monotonic()
-        if n >= expected or time.monotonic() - last_change > quiet_sec:
+            arrived = True
+        if n >= expected or time.monotonic() - last_change > (quiet_sec if arrived else first_sec):
             return got
         time.sleep(0.02)
 
