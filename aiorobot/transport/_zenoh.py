@@ -111,6 +111,11 @@ BACKLOG_LIMIT = 10_000
 #: (fewer when the topic's smallest depth is smaller), and of all topics together
 MAX_CHUNK = 64
 MAX_DRAIN = 256
+#: samples of one topic zenoh holds for the loop to take (:class:`_Puller`): ~27 ms of a 150k
+#: messages/s burst, past the ``STALL_SEC`` after which the puller's thread takes them instead
+PULL_CAPACITY = 4096
+#: a loop that took none of a pulling topic's samples for this long (twice in a row) is stalled
+STALL_SEC = 0.005
 #: a topic received over iceoryx2 and zenoh both delivers each (publisher, sequence number) once
 #: among this many of the publisher's newest
 WINDOW = 256
@@ -459,9 +464,11 @@ class Delivered:
 class _Inbound:
     """One topic's zenoh subscriber; hands checked, decoded messages to the bus.
 
-    zenoh's thread (and the iceoryx2 input's, for ``iceoryx2_topics``) checks and decodes a
-    sample and queues the message in the inbox of the loop the topic's subscriptions run on
-    (all topics, in arrival order); :meth:`_Inbox.drain` injects them there.
+    A plain topic's samples are taken by the loop itself while it keeps up (:class:`_Puller`);
+    a transient-local topic's (zenoh-ext's advanced subscriber) are checked and decoded on zenoh's
+    callback thread. Either way (and the iceoryx2 input's, for ``iceoryx2_topics``) a message is
+    queued in the inbox of the loop the topic's subscriptions run on, where :meth:`_Inbox.drain`
+    injects it.
     """
 
     def __init__(self, transport: ZenohTransport, topic: str, msg_type: Any, type_hash: str) -> None:
@@ -480,6 +487,7 @@ class _Inbound:
         self._declared: Any = None
         self.subscriptions: list[Subscription[Any]] = []
         self.zsub: Any = None
+        self.puller: _Puller | None = None  # a plain subscriber's (None: zenoh-ext's, with a callback)
         self.advanced = False
         self.depth = 0
         self.chunk = MAX_CHUNK
@@ -516,7 +524,7 @@ class _Inbound:
         depth = qos.depth if qos.history is HistoryPolicy.KEEP_LAST else 1000
         if self.zsub is not None and (self.advanced or not want_history) and depth <= self.depth:
             return
-        old = self.zsub
+        old, old_puller = self.zsub, self.puller
         if self._declared is None:
             self._declared = session.declare_keyexpr(self.key)
         self.depth = max(depth, self.depth)
@@ -534,15 +542,24 @@ class _Inbound:
                 recovery=zenoh.ext.RecoveryConfig(periodic_queries=None, heartbeat=True) if reliable else None,
                 subscriber_detection=True,
             )
+            self.puller = None
             self._history_asked.clear()
             self.transport._ask_histories(self)  # (a session asked before: its new querier replaces the old)
         else:
-            self.zsub = session.declare_subscriber(key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
-        if old is not None:
+            self.zsub = session.declare_subscriber(
+                key, zenoh.handlers.FifoChannel(PULL_CAPACITY), allowed_origin=zenoh.Locality.REMOTE
+            )
+            self.puller = _Puller(self, self.zsub)
+        if old_puller is not None:
+            old_puller.close()
+        elif old is not None:
             old.undeclare()
 
     def _on_sample(self, sample: Any) -> None:
-        """On a zenoh thread: check and decode the sample, queue it in the inbox of the loop the
+        """A transient-local topic's zenoh callback (a plain topic's samples go through its
+        :class:`_Puller`, which decodes before waking too).
+
+        On a zenoh thread: check and decode the sample, queue it in the inbox of the loop the
         topic's subscriptions run on, and wake that loop unless a drain is due already (one
         ``call_soon_threadsafe`` per batch of samples that arrive together).
 
@@ -644,12 +661,121 @@ class _Inbound:
         if self.iox is not None:
             self.iox.close()
             self.iox = None
-        if self.zsub is not None:
+        if self.puller is not None:
+            self.puller.close()
+            self.puller = None
+        elif self.zsub is not None:
             self.zsub.undeclare()
-            self.zsub = None
+        self.zsub = None
         if self._declared is not None:
             self.transport._session.undeclare(self._declared)
             self._declared = None
+
+
+class _Puller:
+    """A plain topic's zenoh subscriber whose samples the loop takes itself while it keeps up.
+
+    zenoh queues the topic's samples in a channel. The puller's thread waits for one, checks and
+    decodes it and queues it in the inbox, waking the loop (as a zenoh callback did); the loop,
+    having delivered it, takes the samples that came meanwhile straight from the channel
+    (:meth:`pull`, the topic's chunk at most per drain) until it is dry, then hands back and the
+    thread waits for the next one. In a burst the loop so takes every sample with no thread of
+    ours in between: a zenoh callback thread and the loop took turns at the GIL for every sample,
+    a third of the receiving process's Python time per Twist (docs/zenoh.md).
+
+    A loop that took none for ``STALL_SEC`` twice in a row (a callback blocking it) no longer
+    pulls: the thread takes each sample and queues it (``pushing``), as a callback did, so zenoh's
+    receiving thread does not wait on this topic (other topics, the priority loop's among them,
+    keep flowing) and a loop that stays stalled loses the oldest past ``BACKLOG_LIMIT`` and says so.
+    The thread hands back to the loop once the inbox is empty again. One of the two takes samples
+    at a time, and a taken sample is delivered before any taken after it: each topic's messages
+    keep their order.
+    """
+
+    def __init__(self, inbound: _Inbound, zsub: Any) -> None:
+        self.inbound = inbound
+        self.zsub = zsub
+        self.channel = zsub.handler
+        self.lock = threading.Lock()
+        self.pulling = False  # the loop takes the samples (only it, while this is set)
+        self.pushing = False  # the thread takes them and queues them (the loop stalled)
+        self.handed_back = threading.Event()  # the loop found the channel dry
+        self.taken = 0  # samples the loop took so far: its progress, for the stall watch
+        self.closed = False
+        self.thread = threading.Thread(target=self._run, name=f"aiorobot-zenoh {inbound.topic}", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        """The puller's thread: wait for a sample; queue it; watch the loop take the rest."""
+        inbound, channel = self.inbound, self.channel
+        while not self.closed:
+            try:
+                sample = channel.recv()
+            except Exception:  # noqa: BLE001 - the subscriber was undeclared: its channel closed
+                return
+            decoded = inbound._decode(sample)
+            if decoded is None or self.closed:
+                continue
+            inbox = inbound.inbox or inbound.transport._inbox
+            if self.pushing and inbox.pending:  # the loop has not caught up: queue it, as a callback did
+                inbox.put(inbound, decoded)
+                continue
+            with self.lock:
+                self.pushing = False
+                self.handed_back.clear()
+                self.pulling = True
+            inbox.put(inbound, decoded)  # the loop delivers it, then takes the rest (pull)
+            self._watch()
+
+    def _watch(self) -> None:
+        """Until the loop hands back; stop its pulling when it takes nothing for 2 x ``STALL_SEC``."""
+        seen, idle = self.taken, 0
+        while not self.handed_back.wait(STALL_SEC):
+            with self.lock:
+                if self.handed_back.is_set() or self.closed:
+                    return
+                if self.taken != seen:
+                    seen, idle = self.taken, 0
+                    continue
+                idle += 1
+                if idle >= 2:  # stalled: the thread takes the samples from now on
+                    self.pulling, self.pushing = False, True
+                    return
+
+    def pull(self, batch: EagerBatch, room: int) -> int:
+        """On the loop, after delivering one of the topic's messages: deliver up to ``room`` more
+        samples waiting in the channel; how many it took. Hands back when the channel is dry."""
+        inbound, channel, lock = self.inbound, self.channel, self.lock
+        got = 0
+        while got < room:
+            with lock:
+                if not self.pulling:
+                    return got  # the thread took over meanwhile
+                try:
+                    sample = channel.try_recv()
+                except Exception:  # noqa: BLE001 - undeclared: closed
+                    sample = None
+                if sample is None:
+                    self.pulling = False
+                    self.handed_back.set()
+                    return got
+                self.taken += 1
+            got += 1
+            decoded = inbound._decode(sample)
+            if decoded is not None:
+                inbound._inject(*decoded)
+                if batch.ready:
+                    batch.run()
+        return got
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            self.pulling = False
+            self.handed_back.set()
+        self.zsub.undeclare()  # (the thread's wait on the channel ends)
+        if self.thread is not threading.current_thread():
+            self.thread.join(timeout=5.0)
 
 
 def delivery_loop(subscriptions: list[Any], main: asyncio.AbstractEventLoop | None) -> asyncio.AbstractEventLoop | None:
@@ -665,8 +791,9 @@ def delivery_loop(subscriptions: list[Any], main: asyncio.AbstractEventLoop | No
 
 
 class _Inbox:
-    """Received messages on their way to one loop: ``(inbound, (gid, message))`` in arrival order,
-    injected there by :meth:`drain`, one drain due at a time.
+    """Received messages on their way to one loop: ``(inbound, (gid, message))`` in arrival order
+    (``(inbound, None)``: take more of a pulling topic's samples), injected there by
+    :meth:`drain`, one drain due at a time.
 
     Each loop has its own, so that a topic whose subscriptions run on the priority loop is
     delivered by that loop even while a main-loop callback blocks."""
@@ -705,17 +832,20 @@ class _Inbox:
             post(loop, self.drain)
 
     def drain(self) -> None:
-        """On the inbox's loop: inject queued messages in arrival order, at most ``chunk`` of one
-        topic (its smallest subscription depth) before the dispatchers run; then the next drain.
-        One drain is due at a time; messages that pile up while the process is descheduled so never
-        fill a subscription queue past its depth, and topics keep their relative order. Each
-        message is delivered eagerly (``EagerBatch``): an idle subscription's plain-function
-        callback runs here, not one loop iteration later in its dispatcher."""
+        """On the inbox's loop: inject queued messages in arrival order, and after a pulling
+        topic's message the samples waiting in its channel (:class:`_Puller`), at most ``chunk``
+        of one topic (its smallest subscription depth) before the dispatchers run, and
+        ``MAX_DRAIN`` in all; then the next drain. One drain is due at a time; messages that pile
+        up while the process is descheduled so never fill a subscription queue past its depth, and
+        each topic keeps its order (topics take turns by chunks). Each message is delivered
+        eagerly (``EagerBatch``): an idle subscription's plain-function callback runs here, not one
+        loop iteration later in its dispatcher."""
         pending = self.pending
         taken: dict[_Inbound, int] = {}
+        budget = MAX_DRAIN
         try:
             with EagerBatch() as batch:
-                for _ in range(MAX_DRAIN):
+                while budget > 0:
                     try:
                         inbound, decoded = item = pending.popleft()  # (zenoh's thread may pop the oldest too)
                     except IndexError:
@@ -724,12 +854,23 @@ class _Inbox:
                     if n >= inbound.chunk:
                         pending.appendleft(item)  # the topic's dispatchers run first
                         break
-                    taken[inbound] = n + 1
                     if inbound.zsub is None:
                         continue  # the topic's last subscription left meanwhile
-                    inbound._inject(*decoded)
-                    if batch.ready:
-                        batch.run()
+                    if decoded is not None:  # (None: go on taking a pulling topic's samples)
+                        n += 1
+                        budget -= 1
+                        inbound._inject(*decoded)
+                        if batch.ready:
+                            batch.run()
+                    puller = inbound.puller
+                    if puller is not None and puller.pulling:
+                        room = min(inbound.chunk - n, budget)
+                        got = puller.pull(batch, room)
+                        n += got
+                        budget -= got
+                        if got == room and puller.pulling:
+                            pending.append((inbound, None))  # more may be waiting: after the other topics
+                    taken[inbound] = n
         finally:  # (also when a callback run here raises KeyboardInterrupt: the rest is not stranded)
             self._next()
 

@@ -296,3 +296,83 @@ async def test_a_subscribed_topic_s_key_is_declared_to_the_session_while_it_has_
         node.create_subscription(Twist, "/cmd_vel", lambda m: again.append(int(m.linear.x)), 10)
         await _first_arrival(child, rt, "/cmd_vel", again)  # a new subscription: declared anew, and received
         child.send("bye")
+
+
+def _puller(rt: Runtime, topic: str) -> Any:
+    (inbound,) = [inb for (t, _), inb in rt.transport._inbound.items() if t == topic]
+    assert inbound.puller is not None
+    return inbound.puller
+
+
+async def test_a_burst_is_taken_by_the_loop_itself_whole_and_in_order_and_its_thread_ends_with_the_topic(
+    router_port: int,
+) -> None:
+    """A plain topic's samples are pulled from zenoh's channel by the loop while it keeps up (no
+    thread hop per sample); nothing is lost on the way and each topic keeps its order."""
+    async with _beside(DRIVER, router_port, "base") as (child, rt, node):
+        got: list[int] = []
+        sub = node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), QoSProfile(depth=1000))
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        puller = _puller(rt, "/cmd_vel")
+        child.send("burst 3000")
+        line = await child.expect("done")
+        sent = int(line.split()[1])
+        stream = lambda: [x for x in got if x >= 0]  # noqa: E731
+        await wait_until(lambda: stream()[-1:] == [2999] if stream() else False)
+        assert stream() == sorted(set(stream()))  # in order, once each (the sender may drop at depth 1000)
+        assert sent >= 3000 and rt.transport.statistics().dropped == 0 and sub.dropped == 0
+        assert puller.taken > 0  # the loop took samples itself
+        thread = puller.thread
+        assert thread.is_alive()
+        node.destroy_subscription(sub)
+        assert not thread.is_alive()  # (closed with the topic's last subscription)
+        child.send("bye")
+
+
+BURSTS = """
+from aiorobot.msgs.geometry_msgs import Twist, Vector3
+async def main(rt):
+    node = Node("driver")
+    rt.add_node(node)
+    pub = node.create_publisher(Twist, "/cmd_vel", QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+    say("ready")
+    reader = await stdin_lines()
+    while (line := (await reader.readline()).decode().strip()) != "bye":
+        if line == "ping":
+            pub.publish(Twist(linear=Vector3(x=-1.0)))
+            say("pinged")
+            continue
+        for i in range(int(line.split()[1])):  # burst N, yielding now and then
+            pub.publish(Twist(linear=Vector3(x=float(i))))
+            if i % 50 == 49:
+                await asyncio.sleep(0)
+        say("done")
+"""
+
+
+async def test_a_stalled_loop_s_samples_are_taken_by_the_thread_then_by_the_loop_again(router_port: int) -> None:
+    import time
+
+    async with _beside(BURSTS, router_port, "base") as (child, rt, node):
+        got: list[int] = []
+        node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), QoSProfile(depth=1000))
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        puller = _puller(rt, "/cmd_vel")
+        child.send("burst 500")
+        assert child.proc.stdin is not None
+        await child.proc.stdin.drain()
+        deadline = time.monotonic() + 20
+        while not puller.pushing and time.monotonic() < deadline:  # the loop blocks: the thread takes over
+            time.sleep(0.005)
+        assert puller.pushing
+        await child.expect("done")
+        stream = lambda: [x for x in got if x >= 0]  # noqa: E731
+        await wait_until(lambda: stream()[-1:] == [499] if stream() else False)
+        assert stream() == list(range(500))  # nothing lost (depth 1000, backlog limit far), in order
+        taken = puller.taken
+        got.clear()
+        child.send("burst 2000")  # caught up: the loop takes the samples again
+        await child.expect("done")
+        await wait_until(lambda: stream()[-1:] == [1999] if stream() else False)
+        assert stream() == sorted(set(stream())) and puller.taken > taken and not puller.pushing
+        child.send("bye")
