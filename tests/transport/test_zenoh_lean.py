@@ -29,19 +29,20 @@ async def main(rt):
     say("ready")
     reader = await stdin_lines()
     loop = asyncio.get_running_loop()
-    while (line := (await reader.readline()).decode().strip()) == "ping":  # until the route is up
-        pub.publish(Twist(linear=Vector3(x=-1.0)))
-        say("pinged")
-    how, count = line.split()
-    start = loop.time()
-    for i in range(int(count)):
-        pub.publish(Twist(linear=Vector3(x=float(i))))
-        if how == "steady":  # 1 kHz on the loop's clock
-            await asyncio.sleep(max(0.0, start + (i + 1) / 1000 - loop.time()))
-        elif i % 50 == 49:  # a burst, yielding now and then
-            await asyncio.sleep(0)
-    say("done", rt.transport.statistics().sent)
-    await reader.readline()
+    while (line := (await reader.readline()).decode().strip()) not in ("bye", ""):
+        if line == "ping":  # until the route is up
+            pub.publish(Twist(linear=Vector3(x=-1.0)))
+            say("pinged")
+            continue
+        how, count = line.split()  # steady N | burst N
+        start = loop.time()
+        for i in range(int(count)):
+            pub.publish(Twist(linear=Vector3(x=float(i))))
+            if how == "steady":  # 1 kHz on the loop's clock
+                await asyncio.sleep(max(0.0, start + (i + 1) / 1000 - loop.time()))
+            elif i % 50 == 49:  # a burst, yielding now and then
+                await asyncio.sleep(0)
+        say("done", rt.transport.statistics().sent)
 """
 
 CAMERA = """
@@ -329,31 +330,10 @@ async def test_a_burst_is_taken_by_the_loop_itself_whole_and_in_order_and_its_th
         child.send("bye")
 
 
-BURSTS = """
-from aiorobot.msgs.geometry_msgs import Twist, Vector3
-async def main(rt):
-    node = Node("driver")
-    rt.add_node(node)
-    pub = node.create_publisher(Twist, "/cmd_vel", QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
-    say("ready")
-    reader = await stdin_lines()
-    while (line := (await reader.readline()).decode().strip()) != "bye":
-        if line == "ping":
-            pub.publish(Twist(linear=Vector3(x=-1.0)))
-            say("pinged")
-            continue
-        for i in range(int(line.split()[1])):  # burst N, yielding now and then
-            pub.publish(Twist(linear=Vector3(x=float(i))))
-            if i % 50 == 49:
-                await asyncio.sleep(0)
-        say("done")
-"""
-
-
 async def test_a_stalled_loop_s_samples_are_taken_by_the_thread_then_by_the_loop_again(router_port: int) -> None:
     import time
 
-    async with _beside(BURSTS, router_port, "base") as (child, rt, node):
+    async with _beside(DRIVER, router_port, "base") as (child, rt, node):
         got: list[int] = []
         node.create_subscription(Twist, "/cmd_vel", lambda m: got.append(int(m.linear.x)), QoSProfile(depth=1000))
         await _first_arrival(child, rt, "/cmd_vel", got)
