@@ -683,8 +683,8 @@ class _Puller:
     having delivered it, takes the samples that came meanwhile straight from the channel
     (:meth:`pull`, the topic's chunk at most per drain) until it is dry, then hands back and the
     thread waits for the next one. In a burst the loop so takes every sample with no thread of
-    ours in between: a zenoh callback thread and the loop took turns at the GIL for every sample,
-    a third of the receiving process's Python time per Twist (docs/zenoh.md).
+    ours in between: with a zenoh callback thread, the two took turns at the GIL for every sample
+    (14.8 us of Python-thread CPU per Twist in the bench's burst, against 7.8 us now; docs/zenoh.md).
 
     A loop that took none for ``STALL_SEC`` twice in a row (a callback blocking it) no longer
     pulls: the thread takes each sample and queues it (``pushing``), as a callback did, so zenoh's
