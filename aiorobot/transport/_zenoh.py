@@ -702,7 +702,10 @@ class _Puller:
         self.lock = threading.Lock()
         self.pulling = False  # the loop takes the samples (only it, while this is set)
         self.pushing = False  # the thread takes them and queues them (the loop stalled)
-        self.handed_back = threading.Event()  # the loop found the channel dry
+        #: held by the thread while the loop pulls; the loop releases it when it finds the channel
+        #: dry (a lock as a semaphore: its timed wait is one C call, an Event's a Condition's Python)
+        self.gate = threading.Lock()
+        self.gate.acquire()
         self.taken = 0  # samples the loop took so far: its progress, for the stall watch
         self.closed = False
         self.thread = threading.Thread(target=self._run, name=f"aiorobot-zenoh {inbound.topic}", daemon=True)
@@ -725,7 +728,6 @@ class _Puller:
                 continue
             with self.lock:
                 self.pushing = False
-                self.handed_back.clear()
                 self.pulling = True
             inbox.put(inbound, decoded)  # the loop delivers it, then takes the rest (pull)
             self._watch()
@@ -733,9 +735,12 @@ class _Puller:
     def _watch(self) -> None:
         """Until the loop hands back; stop its pulling when it takes nothing for 2 x ``STALL_SEC``."""
         seen, idle = self.taken, 0
-        while not self.handed_back.wait(STALL_SEC):
+        while not self.gate.acquire(timeout=STALL_SEC):
             with self.lock:
-                if self.handed_back.is_set() or self.closed:
+                if self.closed:
+                    return
+                if not self.pulling:  # handed back since the wait timed out: the gate is open
+                    self.gate.acquire()  # (at once)
                     return
                 if self.taken != seen:
                     seen, idle = self.taken, 0
@@ -760,7 +765,7 @@ class _Puller:
                     sample = None
                 if sample is None:
                     self.pulling = False
-                    self.handed_back.set()
+                    self.gate.release()  # the thread waits for the next sample
                     return got
                 self.taken += 1
             got += 1
@@ -774,8 +779,9 @@ class _Puller:
     def close(self) -> None:
         with self.lock:
             self.closed = True
-            self.pulling = False
-            self.handed_back.set()
+            if self.pulling:  # (the thread waits at the gate)
+                self.pulling = False
+                self.gate.release()
         self.zsub.undeclare()  # (the thread's wait on the channel ends)
         if self.thread is not threading.current_thread():
             self.thread.join(timeout=5.0)
