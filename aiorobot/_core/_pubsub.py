@@ -78,23 +78,15 @@ def deliver_eagerly(publish: Callable[..., Any], *args: Any) -> None:
     whose callback is a coroutine function, whose group is busy, or that takes MessageInfo (or
     was made with ``raw``, or runs under ``debug_messages``) is woken as with any publish; so is
     one that a callback run here publishes to (only the received message is delivered eagerly)."""
-    ready: list[Subscription[Any]] = []
-    _EAGER.ready = ready
-    try:
+    with EagerBatch() as batch:
         publish(*args)
-    except BaseException:
-        _EAGER.ready = None
-        for sub in ready:
-            sub._run_now(run=False)  # their dispatchers take what was queued
-        raise
-    _EAGER.ready = None
-    for sub in ready:
-        sub._run_now()
+        if batch.ready:
+            batch.run()
 
 
 class EagerBatch:
-    """:func:`deliver_eagerly` for a run of received messages (a transport's drain), without its
-    per-message set-up: ``with EagerBatch() as batch:``, then for each message its publish and
+    """:func:`deliver_eagerly` for a run of received messages (a transport's drain), its set-up
+    done once for the run: ``with EagerBatch() as batch:``, then for each message its publish and
     ``if batch.ready: batch.run()``. Same semantics, message by message: the callbacks a
     message woke run before the next message is published, and a message published by one of
     them is not delivered eagerly."""

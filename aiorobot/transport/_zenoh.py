@@ -623,20 +623,16 @@ class _Inbound:
                 self._gid, self._injector = gid, injector
         if injector.destroyed:
             return
-        if not injector._taps:  # nothing it could echo back: no flag to set
-            try:
-                injector.publish(msg)
-            except Exception as err:  # noqa: BLE001
-                self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
-            return
-        local = self.transport._local
-        local.injecting = True  # outbound taps must not echo it back
+        taps = injector._taps  # (none: nothing could echo it back, no flag to set)
+        if taps:
+            self.transport._local.injecting = True  # outbound taps must not echo it back
         try:
             injector.publish(msg)
         except Exception as err:  # noqa: BLE001
             self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
         finally:
-            local.injecting = False
+            if taps:
+                self.transport._local.injecting = False
 
     def _history_answered(self, zid: str, querier: Any, replies: list[tuple[bytes, Any, int]]) -> None:
         """On the loop: session ``zid``'s caches answered ``querier``'s query; done with it."""
