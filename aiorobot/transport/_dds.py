@@ -53,7 +53,7 @@ from ._dds_wire import (
 )
 from .._core._handoff import post
 from ..msgs._cdr import decoder
-from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer, _ThreadFlags, delivery_loop
+from ._zenoh import _FALLBACK_QOS, ZenohTransport, _ignore, _Injector, _own_tap, _Owner, _RemoteClient, _RemoteServer, delivery_loop
 
 if TYPE_CHECKING:
     from .._core._bus import Bus
@@ -191,6 +191,7 @@ class _Outbound:
         self.writer: Any = None
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<dds>", keeps=False)
         self.tap.hidden = True  # type: ignore[attr-defined]
+        self.tap.echo_of = transport._owner  # type: ignore[attr-defined]  # (its injectors skip it)
 
     def declare(self, qos: QoSProfile) -> None:
         merged = _merged(self.qos, qos, reader=False)
@@ -210,8 +211,6 @@ class _Outbound:
     def _send(self, msg: Any) -> None:
         """The tap's callback: runs in the publishing thread."""
         transport = self.transport
-        if transport._local.injecting:
-            return  # it came from the network: do not echo it back
         from cyclonedds._clayer import ddspy_write
 
         from ..msgs import serialize
@@ -423,7 +422,6 @@ class DdsTransport(Transport):
         self._loop: asyncio.AbstractEventLoop | None = None
         self._owner: _Owner = None  # type: ignore[assignment]
         self._lock = threading.RLock()
-        self._local = _ThreadFlags()
         self._ids = itertools.count(1)
         self._topics: dict[tuple[str, str], Any] = {}
         self._outbound: dict[tuple[str, str], _Outbound] = {}
@@ -587,13 +585,10 @@ class DdsTransport(Transport):
             injector = inbound.fallback
         if injector.destroyed:
             return
-        self._local.injecting = True
         try:
-            injector.publish(msg)
+            injector.publish(msg)  # (not to the outbound taps: see _Injector._set_targets)
         except Exception as err:  # noqa: BLE001
             self._warn("inject", f"could not deliver a message on {inbound.topic}: {err}")
-        finally:
-            self._local.injecting = False
 
     def _endpoint_id(self) -> str:
         """rmw_cyclonedds's ``clientid``/``serviceid``: the participant GUID prefix and a counter, as

@@ -180,15 +180,6 @@ class _Owner:
         return _log
 
 
-class _ThreadFlags(threading.local):
-    """Per thread: ``injecting`` is True while the transport publishes into the bus what it
-    received, so that its outbound taps do not echo it back. A class default, so that reading it
-    never raises: ``getattr(local, name, False)`` on a missing name builds an AttributeError, which
-    cost ~6 us per Twist and ~20 us per image on the publish path (cold caches at 1 kHz)."""
-
-    injecting = False
-
-
 class _Injector(Publisher):  # type: ignore[type-arg]
     """Publishes into the bus what a remote publisher sent; its node name is the remote node's."""
 
@@ -211,6 +202,13 @@ class _Injector(Publisher):  # type: ignore[type-arg]
         self.fresh = fresh
         if hidden:
             self._history = None
+
+    def _set_targets(self, subs: tuple[Any, ...], *, leaving: Any = None) -> None:
+        """What it publishes came from its transport: that transport's outbound taps (marked with
+        ``echo_of``, its stand-in node) are left out, so nothing received is sent back. Set up
+        once per change of the topic's endpoints, not tested per message on the send path."""
+        own = self.node
+        super()._set_targets(tuple(s for s in subs if getattr(s, "echo_of", None) is not own), leaving=leaving)
 
     def _accept(self, msg: Any) -> Any:
         if not self.fresh or self._guard is not None:  # (debug_messages: the read-only twin)
@@ -310,6 +308,7 @@ class _Outbound:
         self.said = False  # which way large messages go was logged
         self.tap = Tap(msg_type, topic, _ANY_QOS, self._send, owner="<zenoh>", keeps=False)
         self.tap.hidden = True  # type: ignore[attr-defined]
+        self.tap.echo_of = transport._owner  # type: ignore[attr-defined]  # (its injectors skip it)
 
     def set_gid(self, gid: bytes) -> None:
         """The GID every put's attachment carries (that of the topic's first local publisher)."""
@@ -370,8 +369,8 @@ class _Outbound:
         """The tap's callback: runs in the publishing thread."""
         transport = self.transport
         zpub = self.zpub
-        if zpub is None or transport._local.injecting:
-            return  # closed, or it came from the network: do not echo it back
+        if zpub is None:
+            return  # closed
         iox = self.iox
         if iox is not None and iox.wanted():
             self._send_iceoryx2(msg, iox, zpub)
@@ -623,16 +622,10 @@ class _Inbound:
                 self._gid, self._injector = gid, injector
         if injector.destroyed:
             return
-        taps = injector._taps  # (none: nothing could echo it back, no flag to set)
-        if taps:
-            self.transport._local.injecting = True  # outbound taps must not echo it back
         try:
-            injector.publish(msg)
+            injector.publish(msg)  # (not to the outbound taps: see _Injector._set_targets)
         except Exception as err:  # noqa: BLE001
             self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
-        finally:
-            if taps:
-                self.transport._local.injecting = False
 
     def _history_answered(self, zid: str, querier: Any, replies: list[tuple[bytes, Any, int]]) -> None:
         """On the loop: session ``zid``'s caches answered ``querier``'s query; done with it."""
@@ -968,7 +961,6 @@ class ZenohTransport(Transport):
         self._loop: asyncio.AbstractEventLoop | None = None
         self._owner: _Owner = None  # type: ignore[assignment]
         self._lock = threading.RLock()
-        self._local = _ThreadFlags()
         self._ids = itertools.count(1)
         self._nodes: dict[int, _LocalNode] = {}
         self._tokens: dict[int, Any] = {}  # id(endpoint) -> liveliness token

@@ -12,7 +12,7 @@ import pytest
 
 from aiorobot import Node, QoSProfile, ReliabilityPolicy, Runtime
 from aiorobot.msgs import deserialize, serialize
-from aiorobot.msgs.geometry_msgs import Twist
+from aiorobot.msgs.geometry_msgs import Twist, Vector3
 from aiorobot.msgs.sensor_msgs import Image
 from aiorobot.transport import ZenohTransport
 
@@ -254,6 +254,47 @@ async def test_a_callback_run_on_arrival_publishes_to_other_processes(router_por
             await wait_until(lambda: [x for x in heard if x >= 0] == list(range(20)))
         assert [x for x in relayed if x >= 0] == list(range(20))
         child.send("bye")
+
+
+async def test_a_received_message_is_not_sent_back_by_a_process_that_publishes_its_topic_too(router_port: int) -> None:
+    """Two processes that both publish and subscribe one topic (as /tf is): what one receives goes
+    to its subscriptions and its recorder tap, not out again over zenoh, so nothing comes back."""
+    from aiorobot.lowlevel import Tap, add_tap
+
+    qos = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
+    near_transport = ZenohTransport(connect=[f"tcp/127.0.0.1:{router_port}"])
+    far_transport = ZenohTransport(connect=[f"tcp/127.0.0.1:{router_port}"])
+    async with Runtime(transport=near_transport, handle_signals=False) as near, Runtime(
+        transport=far_transport, handle_signals=False
+    ) as far:
+        here: list[int] = []
+        there: list[int] = []
+        recorded: list[int] = []
+        talker = near.add_node(Node("talker"))
+        pub = talker.create_publisher(Twist, "/chatter", qos)
+        talker.create_subscription(Twist, "/chatter", lambda m: here.append(int(m.linear.x)), qos)
+        other = far.add_node(Node("other"))
+        other.create_publisher(Twist, "/chatter", qos)  # far has an outbound for /chatter too
+        other.create_subscription(Twist, "/chatter", lambda m: there.append(int(m.linear.x)), qos)
+        tap = Tap(Twist, "/chatter", qos, lambda m: recorded.append(int(m.linear.x)), owner="recorder")
+        tap.wants_remote = True  # type: ignore[attr-defined]
+        add_tap(far, tap)
+        await wait_until(lambda: len(near.graph.subscriptions_of("/chatter")) >= 2)
+        await wait_until(lambda: len(far.graph.subscriptions_of("/chatter")) >= 2)
+        n = 0
+        while not there:  # until the route is up
+            n += 1
+            pub.publish(Twist(linear=Vector3(x=-float(n))))
+            with contextlib.suppress(TimeoutError):
+                await wait_until(lambda: bool(there), 0.2)
+        for i in range(20):
+            pub.publish(Twist(linear=Vector3(x=float(i))))
+        await wait_until(lambda: there[-1] == 19 and recorded and recorded[-1] == 19)
+        assert [x for x in there if x >= 0] == list(range(20))
+        assert [x for x in recorded if x >= 0] == list(range(20))
+        assert far_transport.statistics().sent == 0
+        assert len(here) == n + 20  # its own, delivered in process, and none of them twice
+        assert near_transport.statistics().received == 0
 
 
 def test_delivered_passes_each_publisher_s_sequence_number_once_out_of_order_within_its_window() -> None:

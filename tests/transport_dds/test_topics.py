@@ -206,3 +206,35 @@ async def test_a_priority_loop_subscription_receives_while_the_main_loop_is_bloc
         assert arrived.wait(timeout=20), "the priority loop got nothing while the main loop was blocked"
         assert got == [0.75]
         await peer._line(peer.proc)  # the peer's answer to the write
+
+
+async def test_a_received_message_is_not_written_back_by_a_participant_that_publishes_its_topic_too(domain_id: int) -> None:
+    """Two participants that both publish and subscribe one topic (as /tf is): what one receives
+    goes to its subscriptions, not out again over DDS, so nothing comes back."""
+    qos = QoSProfile(depth=50)
+    async with dds_runtime(domain_id) as near, dds_runtime(domain_id) as far:
+        here: list[int] = []
+        there: list[int] = []
+        talker = near.add_node(Node("talker"))
+        pub = talker.create_publisher(Twist, "/chatter", qos)
+        talker.create_subscription(Twist, "/chatter", lambda m: here.append(int(m.linear.x)), qos)
+        other = far.add_node(Node("other"))
+        other.create_publisher(Twist, "/chatter", qos)  # far writes /chatter too
+        other.create_subscription(Twist, "/chatter", lambda m: there.append(int(m.linear.x)), qos)
+        await wait_until(lambda: talker.count_subscribers("/chatter") == 2 and other.count_publishers("/chatter") == 2)
+        n = 0
+        while not there:  # until the reader has matched
+            n += 1
+            pub.publish(Twist(linear=Vector3(x=-float(n))))
+            try:
+                await wait_until(lambda: bool(there), 0.2)
+            except TimeoutError:
+                pass
+        for i in range(20):
+            pub.publish(Twist(linear=Vector3(x=float(i))))
+        await wait_until(lambda: there[-1] == 19)
+        await near.settle()
+        assert [x for x in there if x >= 0] == list(range(20))
+        assert far.transport.statistics().sent == 0
+        assert len(here) == n + 20  # its own, delivered in process, and none of them twice
+        assert near.transport.statistics().received == 0
