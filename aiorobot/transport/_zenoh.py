@@ -111,11 +111,13 @@ BACKLOG_LIMIT = 10_000
 #: (fewer when the topic's smallest depth is smaller), and of all topics together
 MAX_CHUNK = 64
 MAX_DRAIN = 256
-#: samples of one topic zenoh holds for the loop to take (:class:`_Puller`). While the channel is
-#: full, each sample taken wakes zenoh's receiving thread blocked on it (a futex call per sample):
-#: 4,096 left the bench's 20,000-Twist burst 82k msgs/s and 10.1 us of Python CPU per message,
-#: 16,384 108k and 7.8 us. A loop that falls further behind than this makes zenoh wait for it,
-#: while it keeps taking; one that stalls (``STALL_SEC``) has its samples taken by the thread
+#: samples of one topic zenoh holds for the loop to take (:class:`_Puller`), in a ring: a loop
+#: that falls further behind loses the oldest (reported as ``lost``, from the gap they leave in
+#: their publisher's sequence numbers) and zenoh's receiving thread never waits for it, so the
+#: session's other topics (the priority loop's among them) keep flowing. A small one costs the
+#: burst: with a blocking channel of 4,096 the bench's 20,000-Twist burst took 82k msgs/s and
+#: 10.1 us of Python CPU per message, with 16,384 108k and 7.8 us. A loop that stalls
+#: (``STALL_SEC``) has its samples taken by the thread instead
 PULL_CAPACITY = 16384
 #: a loop that took none of a pulling topic's samples for this long (twice in a row) is stalled
 STALL_SEC = 0.005
@@ -501,6 +503,11 @@ class _Inbound:
         self.iox: Any = None  # the iceoryx2 input (iceoryx2_topics): messages may arrive both ways
         self._iox_token: Any = None
         self._delivered = Delivered()
+        #: a plain topic's samples missing from their publishers' sequence numbers, as rmw_zenoh
+        #: counts them: ``lost`` by the decoding side, ``_lost_told`` by the loop that reports them
+        self._last_seq: dict[bytes, int] = {}
+        self.lost = 0
+        self._lost_told = 0
         self._history_asked: set[str] = set()  # sessions whose publishers' caches this inbound queried
         self._queriers: dict[str, tuple[Any, Any]] = {}  # session -> (querier, matching listener) still asking
 
@@ -549,7 +556,7 @@ class _Inbound:
             self.transport._ask_histories(self)  # (a session asked before: its new querier replaces the old)
         else:
             self.zsub = session.declare_subscriber(
-                key, zenoh.handlers.FifoChannel(PULL_CAPACITY), allowed_origin=zenoh.Locality.REMOTE
+                key, zenoh.handlers.RingChannel(PULL_CAPACITY), allowed_origin=zenoh.Locality.REMOTE
             )
             self.puller = _Puller(self, self.zsub)
         if old_puller is not None:
@@ -597,8 +604,13 @@ class _Inbound:
             transport._drop_sample(str(key_expr), err)
             return None
         transport._received += 1
+        seq = _SEQ.unpack_from(att)[0]
         if self.iox is not None or self.advanced:
-            return gid, msg, _SEQ.unpack_from(att)[0]
+            return gid, msg, seq
+        last = self._last_seq.get(gid)
+        self._last_seq[gid] = seq
+        if last is not None and seq > last + 1:  # (a lower one: the publisher started again)
+            self.lost += seq - last - 1
         return gid, msg
 
 
@@ -622,10 +634,28 @@ class _Inbound:
                 self._gid, self._injector = gid, injector
         if injector.destroyed:
             return
+        if self.lost != self._lost_told:
+            self._report_lost()
         try:
             injector.publish(msg)  # (not to the outbound taps: see _Injector._set_targets)
         except Exception as err:  # noqa: BLE001
             self.transport._warn("inject", f"could not deliver a message on {self.topic}: {err}")
+
+    def _report_lost(self) -> None:
+        """On the loop: say how many samples the topic lost since the last report, and count them
+        on its subscriptions' ``message_lost`` events (as rmw_zenoh does)."""
+        n = self.lost - self._lost_told
+        self._lost_told += n
+        self.transport._warn(
+            "lost",
+            f"{n} samples on {self.topic} never arrived (gaps in their publishers' sequence numbers): the "
+            f"publisher or the network dropped them, or this process fell more than {PULL_CAPACITY} behind",
+            count=n,
+        )
+        for sub in self.subscriptions:
+            lost = getattr(sub, "_lost", None)
+            if lost is not None:
+                lost._fire(n)
 
     def _history_answered(self, zid: str, querier: Any, replies: list[tuple[bytes, Any, int]]) -> None:
         """On the loop: session ``zid``'s caches answered ``querier``'s query; done with it."""
@@ -1185,8 +1215,8 @@ class ZenohTransport(Transport):
 
     # -- helpers --------------------------------------------------------------------------
 
-    def _warn(self, reason: str, text: str) -> None:
-        self._drops[reason] += 1
+    def _warn(self, reason: str, text: str, count: int = 1) -> None:
+        self._drops[reason] += count
         now = time.monotonic()
         if now - self._last_warning.get(reason, -1e9) >= WARN_INTERVAL_SEC:
             self._last_warning[reason] = now

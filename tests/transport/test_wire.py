@@ -195,3 +195,50 @@ async def test_malformed_input_from_the_network_is_dropped_counted_and_never_rea
             assert any("dropped a sample" in r.message for r in caplog.records)
     finally:
         s.close()
+
+
+async def test_gaps_in_a_publisher_s_sequence_numbers_are_reported_as_lost_messages(
+    router_port: int, caplog: pytest.LogCaptureFixture
+) -> None:
+    """As rmw_zenoh counts them: per publisher GID, a sequence number more than one past the last
+    one seen means the messages between never arrived. They are counted on the subscription's
+    ``message_lost`` event and said in one line; a publisher that starts again is not a loss."""
+    from aiorobot import SubscriptionEventCallbacks
+
+    s = bare_session(router_port)
+    try:
+        async with peer_runtime(router_port) as rt:
+            node = rt.add_node(Node("listener"))
+            got: list[str] = []
+            lost: list[tuple[int, int]] = []
+            node.create_subscription(
+                String, "/chatter", lambda m: got.append(m.data), 100,
+                event_callbacks=SubscriptionEventCallbacks(message_lost=lambda e: lost.append((e.total_count, e.total_count_change))),
+            )
+            key = f"0/chatter/std_msgs::msg::dds_::String_/{STRING_HASH}"
+            a, b = bytes(range(16)), bytes(range(16, 32))
+
+            def put(gid: bytes, seq: int, text: str) -> None:
+                s.put(key, cdr_string(text), attachment=struct.pack("<qqB", seq, time.time_ns(), 16) + gid)
+
+            seq = 0
+            while not got:  # until the subscriber is reachable
+                seq += 1
+                put(a, seq, "probe")
+                await rt_settle()
+            for n in (1, 2, 5):  # 3 and 4 never come
+                put(a, seq + n, f"a{n}")
+            put(b, 1, "b1")  # another publisher: its own numbers
+            put(b, 2, "b2")
+            put(a, 1, "a again")  # publisher a started again
+            put(a, 2, "a again 2")
+            await wait_until(lambda: "a again 2" in got)
+            await wait_until(lambda: bool(lost))
+            await rt.settle()
+            assert lost == [(2, 2)]
+            stats = rt.transport.statistics()  # type: ignore[attr-defined]
+            assert stats.drop_reasons.get("lost") == 2
+            said = [r.getMessage() for r in caplog.records if "never arrived" in r.getMessage()]
+            assert len(said) == 1 and said[0].startswith("2 samples on /chatter never arrived")
+    finally:
+        s.close()

@@ -230,6 +230,51 @@ async def test_a_loop_stalled_past_the_backlog_limit_loses_the_oldest_and_says_s
         child.send("bye")
 
 
+async def test_a_loop_slower_than_a_burst_loses_the_oldest_of_its_ring_and_says_how_many(
+    router_port: int, monkeypatch: Any, caplog: Any
+) -> None:
+    """The loop keeps taking, but slower than the samples come: zenoh's ring for the topic loses
+    the oldest (zenoh's receiving thread never waits for the loop), and every message of the
+    burst that did not arrive is counted as lost, from its publisher's sequence numbers, on the
+    subscription's ``message_lost`` event and in one line; what arrives keeps its order."""
+    import time
+
+    from aiorobot import SubscriptionEventCallbacks
+    from aiorobot.transport import _zenoh
+
+    monkeypatch.setattr(_zenoh, "PULL_CAPACITY", 64)
+    monkeypatch.setattr(_zenoh, "STALL_SEC", 5.0)  # the loop is slow, not stalled: it takes them all
+    async with _beside(DRIVER, router_port, "slow") as (child, rt, node):
+        got: list[int] = []
+        lost_events: list[int] = []
+
+        def slow(msg: Twist) -> None:
+            got.append(int(msg.linear.x))
+            time.sleep(0.0002)  # a callback slower than the burst
+
+        sub = node.create_subscription(
+            Twist, "/cmd_vel", slow, QoSProfile(depth=100),
+            event_callbacks=SubscriptionEventCallbacks(message_lost=lambda e: lost_events.append(e.total_count_change)),
+        )
+        await _first_arrival(child, rt, "/cmd_vel", got)
+        child.send("burst 3000")
+        await child.expect("done")
+        got_pings = got.count(-1)
+        while got.count(-1) == got_pings:  # a ping after the burst: whatever of it was coming is here
+            child.send("ping")
+            await child.expect("pinged")
+            with contextlib.suppress(TimeoutError):
+                await wait_until(lambda: got.count(-1) > got_pings, timeout_sec=0.5)
+        burst = [x for x in got if x >= 0]
+        lost = rt.transport.statistics().drop_reasons.get("lost", 0)
+        assert burst == sorted(burst) and len(set(burst)) == len(burst)
+        assert lost > 0 and len(burst) + lost == 3000
+        await wait_until(lambda: sum(lost_events) == lost + sub.dropped)
+        said = [r.getMessage() for r in caplog.records if "never arrived" in r.getMessage()]
+        assert said and all(" on /cmd_vel never arrived" in line for line in said)
+        child.send("bye")
+
+
 async def test_a_callback_run_on_arrival_publishes_to_other_processes(router_port: int) -> None:
     """A received message's plain callback runs as the message is delivered (eagerly, not in its
     dispatcher); what it publishes still goes out over zenoh: the transport's guard against echoing
