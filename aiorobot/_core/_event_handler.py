@@ -22,7 +22,9 @@ What produces the events, in process:
 - ``incompatible_qos`` / ``incompatible_type``: raised by the bus's matching, the same
   check that logs (or, under ``strict_qos``, refuses) a pair that does not connect, with
   ``last_policy_kind`` naming the policy.
-- ``message_lost``: a message a full KEEP_LAST queue dropped before the callback took it.
+- ``message_lost``: a message a full KEEP_LAST queue dropped before the callback took it,
+  or (reported by the zenoh transport) one that never arrived: a gap in its publisher's
+  sequence numbers, as rmw_zenoh counts them.
 - ``matched``: the bus connected or disconnected a peer endpoint (a compatible subscription
   for a publisher, a compatible publisher for a subscription; in process or, through a
   transport, remote). ``total_count`` counts connections ever made and ``current_count``
