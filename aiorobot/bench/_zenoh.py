@@ -31,6 +31,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import logging
 import socket
 import subprocess
 import sys
@@ -109,6 +110,9 @@ async def _aiorobot_receiver(port: int, iceoryx2: bool = False) -> None:
     from ..transport import ZenohTransport
 
     rec = _Record()
+    # what a burst loses (the sender's DROP congestion control) is the table's "% of" column, not a
+    # warning line of the receiver's in the middle of the bench's output
+    logging.getLogger("aiorobot.transport").setLevel(logging.ERROR)
     transport = ZenohTransport(domain_id=int(iceoryx2), connect=[f"tcp/127.0.0.1:{port}"], iceoryx2_topics=_iox(iceoryx2))
     async with Runtime(transport=transport, handle_signals=False) as rt:
         node = rt.add_node(Node("bench_sink"))
