@@ -1861,6 +1861,7 @@ class ZenohTransport(Transport):
             inb = self._inbound.get((entry.topic_name, entry.type_name))
             if inb is not None:
                 inb._delivered.forget(gid)
+                inb._last_seq.pop(gid, None)
             entry.destroyed = True
             bus.remove(entry)
         elif isinstance(entry, Tap):
