@@ -429,25 +429,38 @@ class Delivered:
     The ``window`` newest numbers of each publisher are remembered (``WINDOW`` at least; a
     transient-local topic's depth); an older one counts as delivered. A copy is dropped only for a
     publisher marked as reaching this inbound two ways (``seen(..., twice=True)``): one that sends
-    over zenoh alone (an rmw_zenoh node, another host) is never second-guessed on its numbers."""
+    over zenoh alone (an rmw_zenoh node, another host) is never second-guessed on its numbers.
+
+    ``lost`` counts the numbers that left the window never delivered, from the first one seen of
+    each publisher on (``seen(..., count=True)``; an iceoryx2 topic's: its messages may come either
+    way and out of order, so a number is given up only once ``window`` newer ones came)."""
 
     def __init__(self, window: int = 0) -> None:
-        self._by_gid: dict[bytes, list[int]] = {}  # GID -> [newest sequence number, window bits, may come twice]
+        # GID -> [newest sequence number, window bits, may come twice, first number seen]
+        self._by_gid: dict[bytes, list[int]] = {}
         self.window = max(window, WINDOW)
+        self.lost = 0
 
-    def seen(self, gid: bytes, seq: int, twice: bool = False) -> bool:
+    def seen(self, gid: bytes, seq: int, twice: bool = False, count: bool = False) -> bool:
         """Whether ``seq`` of ``gid`` was delivered already; if not, it is from now on. ``twice``:
-        this copy came a way that makes ``gid`` a publisher whose messages may come twice."""
+        this copy came a way that makes ``gid`` a publisher whose messages may come twice;
+        ``count``: count the numbers this one pushes out of the window undelivered in ``lost``."""
         entry = self._by_gid.get(gid)
         if entry is None:
-            self._by_gid[gid] = [seq, 1, twice]
+            self._by_gid[gid] = [seq, 1, twice, seq]
             return False
         if twice:
             entry[2] = True
-        newest, bits, both = entry
+        newest, bits, both, first = entry
         window = self.window
         if seq > newest:
             shift = seq - newest
+            if count and seq - window >= first:  # numbers first.. leave the window: count the undelivered
+                lo, hi = max(newest - window + 1, first), min(newest, seq - window)
+                if hi >= lo:  # these were in the window: their bits say which came
+                    width = hi - lo + 1
+                    self.lost += width - ((bits >> (newest - hi)) & ((1 << width) - 1)).bit_count()
+                self.lost += max(0, seq - window - max(newest, first - 1))  # these never were
             entry[0], entry[1] = seq, ((bits << shift) | 1) & ((1 << window) - 1) if shift < window else 1
             return False
         back = newest - seq
@@ -623,8 +636,12 @@ class _Inbound:
                 newest = self._delivered.newest(gid)
                 if newest is not None and newest - seq >= self.depth:
                     return
-            if self._delivered.seen(gid, seq, iceoryx2 or self.advanced):
+            delivered = self._delivered
+            if delivered.seen(gid, seq, iceoryx2 or self.advanced, count=not self.advanced):
                 return
+            if delivered.lost:  # (an iceoryx2 topic's: a plain one's are counted as they are decoded)
+                self.lost += delivered.lost
+                delivered.lost = 0
         injector = self._injector
         if gid != self._gid or injector is None or injector.destroyed:
             injector = self.transport._by_gid.get(gid)
@@ -646,10 +663,15 @@ class _Inbound:
         on its subscriptions' ``message_lost`` events (as rmw_zenoh does)."""
         n = self.lost - self._lost_told
         self._lost_told += n
+        behind = f"{PULL_CAPACITY} samples"
+        if self.iox is not None:
+            from ._iceoryx2 import BUFFER_SIZE
+
+            behind = f"{PULL_CAPACITY} samples over zenoh or {BUFFER_SIZE} over iceoryx2"
         self.transport._warn(
             "lost",
             f"{n} samples on {self.topic} never arrived (gaps in their publishers' sequence numbers): the "
-            f"publisher or the network dropped them, or this process fell more than {PULL_CAPACITY} behind",
+            f"publisher or the network dropped them, or this process fell more than {behind} behind",
             count=n,
         )
         for sub in self.subscriptions:

@@ -284,6 +284,61 @@ async def test_a_subscriber_killed_with_sigkill_is_released_and_the_publisher_go
         assert said[-1] == alone and said.count(alone) == 2, said
 
 
+async def test_images_the_receiver_was_too_slow_for_are_counted_as_lost_once_newer_ones_came(
+    router_port: int, caplog: Any
+) -> None:
+    """iceoryx2 keeps the newest 8 samples for a subscriber that falls behind. The frames it lost
+    leave gaps in the camera's sequence numbers; as an iceoryx2 topic's messages may come either
+    way and out of order, a missing one is counted lost once ``WINDOW`` newer ones came."""
+    import sys
+    import time
+
+    from aiorobot.transport._iceoryx2 import BUFFER_SIZE
+    from aiorobot.transport._zenoh import WINDOW
+
+    side = 32  # 3 KB: over iceoryx2 (shm_threshold 2 KiB), cheap to send many of
+    async with _viewer(router_port) as rt:
+        images: list[Image] = []
+        rt.add_node(Node("viewer")).create_subscription(Image, _topic(router_port), images.append, 100)
+        camera = await _child(CAMERA, router_port)
+        try:
+            camera.send("served 1")
+            await camera.expect("served")
+            assert await _publish(camera, 0, 1, side) == (0, 1)
+            await wait_until(lambda: len(images) == 1)
+            # this process holds the GIL while the camera sends 40 frames: its iceoryx2 thread cannot
+            # take them, and iceoryx2 keeps the newest BUFFER_SIZE
+            interval = sys.getswitchinterval()
+            sys.setswitchinterval(30.0)
+            try:
+                camera.send(f"1 40 {side}")
+                assert camera.proc.stdin is not None
+                await camera.proc.stdin.drain()
+                end = time.monotonic() + 2.0
+                while time.monotonic() < end:
+                    pass
+            finally:
+                sys.setswitchinterval(interval)
+            await camera.expect("sent")
+            await wait_until(lambda: len(images) >= 1 + BUFFER_SIZE)
+            received = len(images) - 1
+            assert received < 40
+            # frames that arrive whole, a few at a time, until the window has moved past the lost ones
+            first = 41
+            while first < 41 + WINDOW:
+                await _publish(camera, first, 4, side)
+                await wait_until(lambda: len(images) >= received + 1 + (first + 4 - 41))
+                first += 4
+            await rt.settle()
+            stats = rt.transport.statistics()
+            assert stats.drop_reasons.get("lost") == 40 - received
+            said = [r.getMessage() for r in caplog.records if "never arrived" in r.getMessage()]
+            assert said and f"{BUFFER_SIZE} over iceoryx2" in said[0]
+            assert [int(m.header.frame_id) for m in images] == sorted(int(m.header.frame_id) for m in images)
+        finally:
+            await camera.stop()
+
+
 async def test_one_process_publishing_and_subscribing_sends_nothing_to_itself(router_port: int) -> None:
     async with _viewer(router_port) as rt:
         node = rt.add_node(Node("both"))

@@ -378,6 +378,33 @@ def test_delivered_passes_each_publisher_s_sequence_number_once_out_of_order_wit
     assert not d.seen(a, 1)  # (a publisher gone: its numbers forgotten)
 
 
+def test_delivered_counts_a_number_as_lost_once_the_window_has_moved_past_it_undelivered() -> None:
+    """An iceoryx2 topic's messages come two ways and out of order: a number missing now may still
+    come, so it is given up (counted in ``lost``) only once ``WINDOW`` newer ones came, and only
+    from the first number seen of each publisher on."""
+    from aiorobot.transport._zenoh import WINDOW, Delivered
+
+    a, b = b"a" * 16, b"b" * 16
+    d = Delivered()
+    for s in (10, 11, 13, 12, 15):  # 12 late, 14 missing (so far)
+        assert not d.seen(a, s, True, count=True)
+    assert not d.seen(b, 500, count=True)  # another publisher, first seen late: nothing before it counts
+    assert d.lost == 0
+    assert not d.seen(a, 14 + WINDOW - 1, count=True)  # 14 is still in the window
+    assert d.lost == 0
+    assert not d.seen(a, 14 + WINDOW, count=True)  # ... now it is not: lost (16.. are still in the window)
+    assert d.lost == 1
+    d.lost = 0
+    assert not d.seen(a, 14 + 3 * WINDOW, count=True)  # a jump: 16..526 leave, but 269 and 270 came
+    assert d.lost == (14 + 2 * WINDOW) - 16 + 1 - 2
+    d.lost = 0
+    assert d.seen(a, 14, True, count=True) and d.lost == 0  # too old: counted as delivered, nothing more
+    transient = Delivered()  # a transient-local topic's history is partial by design: not counted
+    for s in (1, 5, 900):
+        transient.seen(a, s, True)
+    assert transient.lost == 0
+
+
 async def test_a_subscribed_topic_s_key_is_declared_to_the_session_while_it_has_subscriptions(router_port: int) -> None:
     """zenoh caches the route of a sample whose key is a declared resource, and computes it for every
     other sample against every declaration of the session (half the receiving thread's time for
