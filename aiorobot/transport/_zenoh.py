@@ -621,9 +621,10 @@ class _Inbound:
         if self.iox is not None or self.advanced:
             return gid, msg, seq
         last = self._last_seq.get(gid)
-        self._last_seq[gid] = seq
-        if last is not None and seq > last + 1:  # (a lower one: the publisher started again)
-            self.lost += seq - last - 1
+        if last is None or seq > last:  # (a lower one, a copy that came twice as the subscriber was
+            self._last_seq[gid] = seq  # declared again, changes nothing)
+            if last is not None and seq > last + 1:
+                self.lost += seq - last - 1
         return gid, msg
 
 
