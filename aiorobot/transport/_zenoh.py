@@ -436,10 +436,21 @@ class Delivered:
     way and out of order, so a number is given up only once ``window`` newer ones came)."""
 
     def __init__(self, window: int = 0) -> None:
-        # GID -> [newest sequence number, window bits, may come twice, first number seen]
+        # GID -> [newest sequence number, window bits, may come twice, first number counted]
         self._by_gid: dict[bytes, list[int]] = {}
-        self.window = max(window, WINDOW)
+        self._window = max(window, WINDOW)
         self.lost = 0
+
+    @property
+    def window(self) -> int:
+        return self._window
+
+    @window.setter
+    def window(self, value: int) -> None:
+        if value > self._window:  # (a deeper subscription): numbers past the old window were counted
+            for entry in self._by_gid.values():
+                entry[3] = max(entry[3], entry[0] - self._window + 1)
+        self._window = max(value, self._window)
 
     def seen(self, gid: bytes, seq: int, twice: bool = False, count: bool = False) -> bool:
         """Whether ``seq`` of ``gid`` was delivered already; if not, it is from now on. ``twice``:

@@ -399,6 +399,13 @@ def test_delivered_counts_a_number_as_lost_once_the_window_has_moved_past_it_und
     assert d.lost == (14 + 2 * WINDOW) - 16 + 1 - 2
     d.lost = 0
     assert d.seen(a, 14, True, count=True) and d.lost == 0  # too old: counted as delivered, nothing more
+    d = Delivered()
+    for s in range(1, 301):
+        d.seen(a, s, count=True)
+    d.window = 1000  # a deeper subscription joins: the numbers past the old window came, or were counted
+    for s in range(301, 1401):
+        d.seen(a, s, count=True)
+    assert d.lost == 0
     transient = Delivered()  # a transient-local topic's history is partial by design: not counted
     for s in (1, 5, 900):
         transient.seen(a, s, True)
