@@ -471,7 +471,7 @@ class Delivered:
                 if hi >= lo:  # these were in the window: their bits say which came
                     width = hi - lo + 1
                     self.lost += width - ((bits >> (newest - hi)) & ((1 << width) - 1)).bit_count()
-                self.lost += max(0, seq - window - max(newest, first - 1))  # these never were
+                self.lost += max(0, seq - window - newest)  # these never were (newest >= first)
             entry[0], entry[1] = seq, ((bits << shift) | 1) & ((1 << window) - 1) if shift < window else 1
             return False
         back = newest - seq
@@ -740,9 +740,10 @@ class _Puller:
     (14.8 us of Python-thread CPU per Twist in the bench's burst, against 7.8 us now; docs/zenoh.md).
 
     A loop that took none for ``STALL_SEC`` twice in a row (a callback blocking it) no longer
-    pulls: the thread takes each sample and queues it (``pushing``), as a callback did, so zenoh's
-    receiving thread does not wait on this topic (other topics, the priority loop's among them,
-    keep flowing) and a loop that stays stalled loses the oldest past ``BACKLOG_LIMIT`` and says so.
+    pulls: the thread takes each sample and queues it (``pushing``), as a callback did, so the
+    samples are checked and decoded while the loop is held up, and a loop that stays stalled loses
+    the oldest past ``BACKLOG_LIMIT`` and says so. (zenoh's receiving thread never waits on the
+    topic either way: its channel is a ring, ``PULL_CAPACITY``.)
     The thread hands back to the loop once the inbox is empty again. One of the two takes samples
     at a time, and a taken sample is delivered before any taken after it: each topic's messages
     keep their order.
